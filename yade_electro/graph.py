@@ -1,0 +1,187 @@
+"""Contact graph of a particle assembly: spherical elements (nodes) and bonds (edges).
+
+The graph is the only thing the numerical core knows about a packing. It is a frozen
+dataclass of numpy arrays, validated on construction, so every model downstream can
+rely on finite positions, positive radii and well-formed, duplicate-free edges.
+
+Units: positions and radii in metres.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .errors import GraphError
+
+__all__ = ["ContactGraph"]
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class ContactGraph:
+    """Spherical elements and the bonds between them.
+
+    Parameters
+    ----------
+    pos : (n, 3) float array
+        Element centres [m].
+    radius : (n,) float array
+        Element radii [m], all > 0.
+    edges : (m, 2) int array
+        Node indices (0..n-1) of each bond; stored with ``i < j``, no duplicates and
+        no self loops (duplicates raise, order is normalised).
+    ids : (n,) int array, optional
+        The caller's identifier of every node (YADE body ids). Defaults to ``arange(n)``.
+    revision : int
+        A counter the producer bumps when the graph changes; consumers use it, with
+        ``key``, to reuse work done on an unchanged graph.
+    """
+
+    pos: np.ndarray
+    radius: np.ndarray
+    edges: np.ndarray
+    ids: np.ndarray = None  # type: ignore[assignment]
+    revision: int = 0
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self):
+        pos = np.asarray(self.pos, dtype=float)
+        if pos.ndim != 2 or pos.shape[1] != 3:
+            raise GraphError(f"pos must have shape (n, 3), got {pos.shape}")
+        n = pos.shape[0]
+        if n == 0:
+            raise GraphError("the graph has no elements: the simulation has no spheres "
+                             "(or the selection kept none); add spherical bodies first")
+        radius = np.asarray(self.radius, dtype=float).reshape(-1)
+        if radius.shape != (n,):
+            raise GraphError(f"radius must have shape ({n},), got {radius.shape}")
+        if not np.all(np.isfinite(pos)):
+            bad = np.flatnonzero(~np.all(np.isfinite(pos), axis=1))
+            raise GraphError(f"non-finite positions at nodes {bad[:10].tolist()}")
+        if not np.all(np.isfinite(radius)) or np.any(radius <= 0):
+            bad = np.flatnonzero(~(np.isfinite(radius) & (radius > 0)))
+            raise GraphError(f"radius must be finite and > 0; bad at nodes {bad[:10].tolist()} "
+                             f"(values {radius[bad[:5]].tolist()})")
+        edges = np.asarray(self.edges, dtype=np.int64)
+        if edges.size == 0:
+            edges = edges.reshape(0, 2)
+        if edges.ndim != 2 or edges.shape[1] != 2:
+            raise GraphError(f"edges must have shape (m, 2), got {edges.shape}")
+        if edges.size and (edges.min() < 0 or edges.max() >= n):
+            raise GraphError(f"edge node index out of range 0..{n - 1}")
+        if np.any(edges[:, 0] == edges[:, 1]):
+            raise GraphError("edges contain self loops (a node bonded to itself)")
+        edges = np.sort(edges, axis=1)
+        key = edges[:, 0] * n + edges[:, 1]
+        if np.unique(key).size != key.size:
+            raise GraphError("edges contain duplicate bonds")
+        ids = np.arange(n) if self.ids is None else np.asarray(self.ids, dtype=np.int64)
+        if ids.shape != (n,):
+            raise GraphError(f"ids must have shape ({n},), got {ids.shape}")
+        if np.unique(ids).size != n:
+            raise GraphError("ids must be unique")
+        object.__setattr__(self, "pos", _readonly(pos))
+        object.__setattr__(self, "radius", _readonly(radius))
+        object.__setattr__(self, "edges", _readonly(edges))
+        object.__setattr__(self, "ids", _readonly(ids))
+
+    # -- sizes ---------------------------------------------------------------------------
+    @property
+    def n_nodes(self) -> int:
+        return self.pos.shape[0]
+
+    @property
+    def n_edges(self) -> int:
+        return self.edges.shape[0]
+
+    # -- derived quantities (cached: the graph is immutable) ------------------------------
+    def _cached(self, name, make):
+        c = self._cache
+        if name not in c:
+            v = make()
+            if isinstance(v, np.ndarray):
+                v.setflags(write=False)
+            c[name] = v
+        return c[name]
+
+    @property
+    def length(self) -> np.ndarray:
+        """Centre-to-centre distance l_ij of each edge [m]."""
+        def make():
+            d = self.pos[self.edges[:, 1]] - self.pos[self.edges[:, 0]]
+            return np.sqrt(np.einsum("ij,ij->i", d, d))
+        return self._cached("length", make)
+
+    @property
+    def degree(self) -> np.ndarray:
+        """Number of bonds n_i of each node."""
+        return self._cached("degree", lambda: np.bincount(self.edges.ravel(), minlength=self.n_nodes))
+
+    @property
+    def volume(self) -> np.ndarray:
+        """Sphere volume 4/3 pi r^3 of each node [m^3]."""
+        return self._cached("volume", lambda: 4.0 / 3.0 * np.pi * self.radius ** 3)
+
+    @property
+    def incidence(self) -> sp.csr_matrix:
+        """Incidence matrix A (m x n): row k has -1 at edges[k,0] and +1 at edges[k,1]."""
+        def make():
+            m, n = self.n_edges, self.n_nodes
+            rows = np.repeat(np.arange(m), 2)
+            cols = self.edges.ravel()
+            vals = np.tile([-1.0, 1.0], m)
+            return sp.csr_matrix((vals, (rows, cols)), shape=(m, n))
+        return self._cached("incidence", make)
+
+    @property
+    def components(self) -> tuple:
+        """(count, label per node) of the connected components of the bond graph."""
+        def make():
+            n = self.n_nodes
+            adj = sp.coo_matrix((np.ones(self.n_edges), (self.edges[:, 0], self.edges[:, 1])), shape=(n, n))
+            return connected_components(adj, directed=False)
+        return self._cached("components", make)
+
+    def index_of(self, ids) -> np.ndarray:
+        """Node indices of the given caller ids (e.g. YADE body ids); unknown ids raise."""
+        ids = np.atleast_1d(np.asarray(ids, dtype=np.int64))
+        order = self._cached("id_order", lambda: np.argsort(self.ids))
+        sorted_ids = self.ids[order]
+        pos = np.searchsorted(sorted_ids, ids)
+        pos = np.clip(pos, 0, self.n_nodes - 1)
+        found = sorted_ids[pos] == ids
+        if not np.all(found):
+            raise GraphError(f"ids not in the graph: {ids[~found][:10].tolist()}")
+        return order[pos]
+
+    def neighbour_barycentre(self) -> np.ndarray:
+        """Mean position of the bonded neighbours of each node [m]; a node with no
+        neighbour gets its own position."""
+        def make():
+            n = self.n_nodes
+            i, j = self.edges[:, 0], self.edges[:, 1]
+            s = np.stack([np.bincount(i, self.pos[j, k], n) + np.bincount(j, self.pos[i, k], n)
+                          for k in range(3)], axis=1)
+            deg = self.degree
+            out = self.pos.copy()
+            has = deg > 0
+            out[has] = s[has] / deg[has, None]
+            return out
+        return self._cached("barycentre", make)
+
+    def with_edges(self, edges, revision=None) -> "ContactGraph":
+        """A new graph with the same elements and other bonds (e.g. after bonds broke)."""
+        return ContactGraph(self.pos, self.radius, edges, self.ids,
+                            self.revision + 1 if revision is None else revision)
+
+    def subgraph(self, keep_edges) -> "ContactGraph":
+        """A new graph with the same elements and only the edges where ``keep_edges`` is true."""
+        return self.with_edges(self.edges[np.asarray(keep_edges, dtype=bool)])

@@ -1,0 +1,175 @@
+"""The electrical engine for ``O.engines``: a ``PyRunner`` that reads the graph (only what
+changed), solves the potentials, writes them back to the bodies and appends a history row.
+
+Example (in a YADE script)::
+
+    from yade import pack
+    from yade_electro.yade import ElectricalEngine
+    electro = ElectricalEngine(
+        resistivity=0.73e-6,
+        electrodes={"top": dict(select=pack.inAlignedBox((-1, -1, 4.9e-3), (1, 1, 1)), potential=1.0),
+                    "bottom": dict(select=pack.inAlignedBox((-1, -1, -1), (1, 1, 0.1e-3)), potential=0.0)},
+        iterPeriod=100, history="electro.csv")
+    O.engines = O.engines + [electro.runner]
+    O.run(1000, True)
+    print(electro.equivalent_resistance, electro.potential_by_id[0])
+    df = electro.history.to_dataframe()
+
+Electrode selectors: YADE predicates (selection by element centre), lists of body ids,
+boolean masks, or callables ``f(pos, radius) -> mask``; ``dict(mask=m)`` selects the
+bodies with ``b.mask & m``.
+"""
+from __future__ import annotations
+
+import logging
+from typing import Dict, Optional
+
+import numpy as np
+
+from ..engine import ElectricalModel, ElectrodeSpec, History
+from .runtime import import_yade
+from .scene import SceneReader, predicate_selector, write_body_attribute
+
+__all__ = ["ElectricalEngine", "ENGINES", "get_engine"]
+
+log = logging.getLogger(__name__)
+
+#: Engines by label, so that the PyRunner command (a string YADE evaluates) can reach them.
+ENGINES: Dict[str, "ElectricalEngine"] = {}
+
+
+def get_engine(label: str) -> "ElectricalEngine":
+    """The ElectricalEngine registered under ``label``."""
+    try:
+        return ENGINES[label]
+    except KeyError:
+        raise KeyError(f"no yade-electro engine labelled {label!r}; have {sorted(ENGINES)}") from None
+
+
+def _is_predicate(obj) -> bool:
+    return callable(obj) and hasattr(obj, "aabb") and hasattr(obj, "dim")
+
+
+def _normalise_selector(sel, reader: SceneReader):
+    if _is_predicate(sel):
+        return predicate_selector(sel)
+    if isinstance(sel, dict) and set(sel) == {"mask"}:
+        m = int(sel["mask"])
+
+        def by_mask(pos, radius):
+            return np.array([bool(b.mask & m) for b in reader.bodies])
+        return by_mask
+    return sel
+
+
+class ElectricalEngine:
+    """Electrical conduction solved every ``iterPeriod`` steps of a YADE simulation.
+
+    Parameters
+    ----------
+    resistivity : float
+        rho_e [ohm m].
+    electrodes : dict name -> dict(select=..., potential=V | current=A)
+    law, law_params, solver, measure : see ``yade_electro.engine.ElectricalModel``
+    iterPeriod : int
+        Steps between two solves (the PyRunner's period).
+    history : str, optional
+        CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
+    bonds, mask, geometry_every, move_tolerance : see ``SceneReader``
+    write_back : str or None
+        Body attribute that receives each element's potential [V] (default 'potential');
+        None to skip.
+    plot : bool
+        Also feed ``yade.plot.addData`` with the history row.
+    label : str
+        Label of the PyRunner and key in ``ENGINES``.
+    """
+
+    def __init__(self, resistivity, electrodes, law="continuum", law_params=None, solver="cg",
+                 measure=None, iterPeriod: int = 1, history: Optional[str] = None, bonds="cohesive",
+                 mask=None, geometry_every: int = 1, move_tolerance: float = 1e-4,
+                 write_back: Optional[str] = "potential", plot: bool = False, label: str = "electro",
+                 O=None):
+        yade = import_yade()
+        self.O = O if O is not None else yade.Omega()
+        self.reader = SceneReader(self.O, bonds=bonds, mask=mask, geometry_every=geometry_every,
+                                  move_tolerance=move_tolerance)
+        specs = []
+        for name, spec in dict(electrodes).items():
+            spec = dict(spec)
+            spec["select"] = _normalise_selector(spec.get("select"), self.reader)
+            specs.append(ElectrodeSpec(name, **spec))
+        self.model = ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver,
+                                     measure=measure)
+        self.history = History(history)
+        self.write_back = write_back
+        self.plot = plot
+        self.label = label
+        self.values: Dict[str, float] = {}
+        ENGINES[label] = self
+        self.runner = yade.PyRunner(
+            command=f"__import__('yade_electro.yade.engines', fromlist=['get_engine']).get_engine({label!r}).step()",
+            iterPeriod=int(iterPeriod), label=label)
+
+    # -- stepping ------------------------------------------------------------------------
+    def set_electrode(self, name: str, value: float):
+        """Change an electrode's potential [V] or current [A] from the next solve on."""
+        if name not in [s.name for s in self.model.specs]:
+            raise KeyError(f"no electrode {name!r}")
+        self.values[name] = float(value)
+
+    def step(self):
+        """One solve on the current scene (what the PyRunner calls)."""
+        graph = self.reader.read()
+        sol = self.model.solve(graph, self.values or None)
+        if self.write_back:
+            write_body_attribute(self.reader.bodies, self.write_back, sol.potential)
+        row = {"iter": int(self.O.iter), "time": float(self.O.time)}
+        row.update(self.model.summary())
+        row["graph_revision"] = int(graph.revision)
+        self.history.append(row)
+        if self.plot:
+            from yade import plot
+            plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
+        return sol
+
+    # -- results -------------------------------------------------------------------------
+    @property
+    def graph(self):
+        return self.model.graph
+
+    @property
+    def solution(self):
+        return self.model.solution
+
+    @property
+    def equivalent_resistance(self) -> float:
+        """R_eq [ohm] between the ``measure`` electrodes at the last solve."""
+        return self.model.equivalent_resistance
+
+    @property
+    def body_ids(self) -> np.ndarray:
+        return self.graph.ids
+
+    @property
+    def potential(self) -> np.ndarray:
+        """Potential [V] of each element, in ``body_ids`` order."""
+        return self.solution.potential
+
+    @property
+    def potential_by_id(self) -> Dict[int, float]:
+        return dict(zip(self.graph.ids.tolist(), self.solution.potential.tolist()))
+
+    @property
+    def branch_currents(self):
+        """(id pairs (m, 2), current (m,) [A] flowing from the first body to the second)."""
+        return self.graph.ids[self.graph.edges], self.solution.branch_current
+
+    @property
+    def electrode_currents(self) -> Dict[str, float]:
+        return dict(self.solution.electrode_current)
+
+    def remove(self):
+        """Take the engine out of ``O.engines`` and the registry."""
+        self.O.engines = [e for e in self.O.engines if e is not self.runner]
+        ENGINES.pop(self.label, None)
