@@ -17,13 +17,20 @@ continuum
 contact
     Constriction conductance of two overlapping spheres (papers 002, 003): c = 2 a / rho,
     a the radius of the contact circle of the lens.
+voronoi
+    Faces of the Voronoi tessellation of the element centres, bounded by the solid's
+    ``container`` (required: an object with ``sdf`` and ``gradient``, e.g. a shape of
+    ``yade_electro.yade.packing``): c_ij = A_ij / (rho l_ij). Exact for uniform fields, no
+    constant to choose (see ``yade_electro.voronoi``). A face conducts while its two
+    elements are linked by a path of at most ``hops`` (default 3) intact bonds, so cracks
+    (broken bonds) cut the current; the faces are computed once on the first configuration.
 liggghts
     The form LIGGGHTS' heat-conduction fix uses: c = 4 k1 k2 / (k1 + k2) sqrt(pi a^2),
     k = 1/rho; for equal materials c = 2 sqrt(pi) a / rho.
 """
 from __future__ import annotations
 
-from typing import Callable, Dict
+from typing import Callable, Dict, Optional
 
 import numpy as np
 
@@ -31,20 +38,43 @@ from .errors import MaterialError
 from .graph import ContactGraph
 from .surfaces import edge_transmission_surface
 
-__all__ = ["conductance", "conductance_laws", "register_conductance_law", "check_resistivity",
+__all__ = ["conductance", "conductance_laws", "network_graph", "register_conductance_law", "check_resistivity",
            "contact_radius", "edge_resistivity"]
 
 _LAWS: Dict[str, Callable] = {}
+_EXPANDERS: Dict[str, Callable] = {}
 
 
-def register_conductance_law(name: str):
-    """Decorator that adds a law ``f(graph, resistivity, **params) -> (m,) array`` to the registry."""
+def register_conductance_law(name: str, expand: Optional[Callable] = None):
+    """Decorator that adds a law ``f(graph, resistivity, **params) -> (m,) array`` to the registry.
+
+    ``expand(graph, **params) -> graph``, optional, gives the network the law conducts on
+    when it is not the bond graph itself (the ``voronoi`` law adds the faces of non-bonded
+    Voronoi neighbours); see :func:`network_graph`.
+    """
     def deco(fn):
         if name in _LAWS:
             raise ValueError(f"conductance law {name!r} is already registered")
         _LAWS[name] = fn
+        if expand is not None:
+            _EXPANDERS[name] = expand
         return fn
     return deco
+
+
+def network_graph(graph: ContactGraph, law: str = "continuum", **params) -> ContactGraph:
+    """The graph whose edges carry current under ``law``: the bond graph itself, or (for laws
+    with an expander, e.g. 'voronoi') a graph with the same nodes and more edges."""
+    _law(law)
+    fn = _EXPANDERS.get(law)
+    return graph if fn is None else fn(graph, **params)
+
+
+def _law(law):
+    try:
+        return _LAWS[law]
+    except KeyError:
+        raise KeyError(f"unknown conductance law {law!r}; known laws: {', '.join(conductance_laws())}") from None
 
 
 def conductance_laws() -> tuple:
@@ -83,10 +113,7 @@ def conductance(graph: ContactGraph, resistivity, law: str = "continuum", **para
     MaterialError
         Resistivity not finite and positive.
     """
-    try:
-        fn = _LAWS[law]
-    except KeyError:
-        raise KeyError(f"unknown conductance law {law!r}; known laws: {', '.join(conductance_laws())}") from None
+    fn = _law(law)
     rho = check_resistivity(resistivity, graph.n_nodes)
     c = fn(graph, rho, **params)
     if not np.all(np.isfinite(c)) or np.any(c < 0):
@@ -130,3 +157,34 @@ def liggghts_conductance(graph: ContactGraph, rho):
     else:
         k1, k2 = 1.0 / rho[graph.edges[:, 0]], 1.0 / rho[graph.edges[:, 1]]
     return 4.0 * k1 * k2 / (k1 + k2) * np.sqrt(np.pi) * contact_radius(graph)
+
+
+def _voronoi_faces_for(graph: ContactGraph, container, cache):
+    from .voronoi import VoronoiFaces
+    if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
+        raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
+                         "and gradient(x) (e.g. yade_electro.yade.packing.as_shape(predicate)); "
+                         f"got {container!r}")
+    # the tessellation is made once, on the first (reference) configuration, and kept while
+    # the same elements are there: moving elements change l_ij, not the face areas
+    # (small-strain view); a new element set, or ElectricalModel.reset(), makes it anew
+    key = ("voronoi", graph.n_nodes, graph.ids.tobytes(), id(container))
+    if cache is not None and cache.get("key") == key:
+        return cache["faces"]
+    faces = VoronoiFaces.of(graph, container)
+    if cache is not None:
+        cache.clear()
+        cache.update(key=key, faces=faces, container=container)
+    return faces
+
+
+def _voronoi_expand(graph: ContactGraph, container=None, cache=None, hops: int = 3):
+    faces = _voronoi_faces_for(graph, container, cache)
+    return graph.with_edges(faces.supported_pairs(graph.edges, hops), revision=graph.revision)
+
+
+@register_conductance_law("voronoi", expand=_voronoi_expand)
+def voronoi_conductance(graph: ContactGraph, rho, container=None, cache=None, hops: int = 3):
+    """c_ij = A_ij / (rho l_ij), A_ij the Voronoi face of i and j inside the container."""
+    faces = _voronoi_faces_for(graph, container, cache)
+    return faces.area_of(graph.edges) / (edge_resistivity(graph, rho) * graph.length)

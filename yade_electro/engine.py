@@ -14,7 +14,7 @@ Units: SI (ohm m, V, A, ohm, W, s).
 from __future__ import annotations
 
 import csv
-import io
+import inspect
 import logging
 import os
 from dataclasses import dataclass
@@ -22,7 +22,7 @@ from typing import Callable, Dict, Iterable, List, Mapping, Optional, Sequence, 
 
 import numpy as np
 
-from .conductance import check_resistivity, conductance
+from .conductance import _law, check_resistivity, conductance, network_graph
 from .errors import BoundaryConditionError
 from .graph import ContactGraph
 from .network import ConductionProblem, Electrode, PotentialSolution
@@ -189,6 +189,14 @@ class ElectricalModel:
         self.conductance: Optional[np.ndarray] = None
         self.solution: Optional[PotentialSolution] = None
         self.rebuilds = 0
+        self.bond_graph: Optional[ContactGraph] = None
+        self._law_cache: dict = {}
+
+    def reset(self):
+        """Forget everything derived from earlier graphs (conductances, tessellation, solver setup)."""
+        self._key = None
+        self.problem = None
+        self._law_cache.clear()
 
     def set_resistivity(self, resistivity):
         """Change rho_e (scalar or per node); the next solve rebuilds the conductances."""
@@ -200,11 +208,15 @@ class ElectricalModel:
         key = (id(graph), graph.revision, graph.n_nodes, graph.n_edges)
         if self.problem is not None and key == self._key:
             return self.problem
-        c = conductance(graph, self.resistivity, self.law, **self.law_params)
-        electrodes = [s.resolve(graph) for s in self.specs]
+        params = dict(self.law_params)
+        if "cache" in inspect.signature(_law(self.law)).parameters:
+            params["cache"] = self._law_cache
+        net = network_graph(graph, self.law, **params)
+        c = conductance(net, self.resistivity, self.law, **params)
+        electrodes = [s.resolve(net) for s in self.specs]
         solver = self.problem.solver if (self.problem is not None and not isinstance(self.solver, str)) else self.solver
-        self.problem = ConductionProblem(graph.n_nodes, graph.edges, c, electrodes, solver=solver)
-        self.graph, self.conductance, self._key = graph, c, key
+        self.problem = ConductionProblem(net.n_nodes, net.edges, c, electrodes, solver=solver)
+        self.bond_graph, self.graph, self.conductance, self._key = graph, net, c, key
         self.rebuilds += 1
         return self.problem
 

@@ -1,0 +1,112 @@
+"""Electrical benchmark on the bonded rods of the rod case (5,000 and 20,000 elements).
+
+Prints, per size: graph extraction from YADE (full read, and the cheap unchanged check),
+assembly (conductances + reduced Kirchhoff system), solve time cold (first solve, solver
+setup included) and re-solve with an unchanged graph, for each solver, and the time of one
+YADE mechanical step on the same bonded packing. Ends with one JSON line.
+
+    yade -n -x bench/bench_electro.py [--sizes 5000,20000] [--repeat 5]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))
+
+from yade_electro.yade.runtime import import_yade  # noqa: E402
+
+
+def best(fn, repeat):
+    """Best wall time [s] of ``repeat`` calls of fn (and the last result)."""
+    t_best, out = float("inf"), None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        t_best = min(t_best, time.perf_counter() - t)
+    return t_best, out
+
+
+def bench_size(n, repeat=5, seed=1):
+    yade = import_yade()
+    from yade import pack
+    from yade_electro.conductance import conductance
+    from yade_electro.network import ConductionProblem, Electrode, make_solver
+    from yade_electro.yade import SceneReader
+    from yade_electro.yade import packing as P
+    sys.path.insert(0, os.path.join(os.path.dirname(HERE), "cases"))
+    import rod_resistance as rod
+
+    O = yade.Omega()
+    O.reset()
+    packing = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS), n=n, seed=seed)
+    ids = np.asarray(P.add_bonded_packing(packing))
+    r_mean = float(np.mean(packing.radii))
+    bottom, top = rod.end_layers(packing.centers[:, 2], packing.radii, r_mean)
+    out = {"n": int(len(ids))}
+
+    def full_read():
+        reader = SceneReader(O, geometry_every=0)
+        return reader, reader.read()
+    out["extract_full_ms"], (reader, graph) = best(full_read, repeat)
+    out["n_edges"] = int(graph.n_edges)
+    out["extract_unchanged_ms"], _ = best(reader.read, repeat)
+    reader_geo = SceneReader(O, geometry_every=1)
+    reader_geo.read()
+    out["extract_unchanged_with_positions_ms"], _ = best(reader_geo.read, repeat)
+
+    def assemble():
+        c = conductance(graph, rod.RHO_304L)
+        el = [Electrode("top", graph.index_of(ids[top]), potential=1.0),
+              Electrode("bottom", graph.index_of(ids[bottom]), potential=0.0)]
+        return ConductionProblem(graph.n_nodes, graph.edges, c, el, solver="direct")
+    out["assembly_ms"], problem = best(assemble, repeat)
+
+    for name in ("cg", "cg-amg", "direct"):
+        try:
+            make_solver(name)
+        except Exception:  # pragma: no cover
+            continue
+
+        def cold():
+            problem.solver = make_solver(name)
+            problem._x_prev = None
+            return problem.solve()
+        t_cold, sol = best(cold, repeat)
+        t_re, sol2 = best(problem.solve, repeat)
+        out[f"{name}_cold_ms"] = t_cold
+        out[f"{name}_resolve_ms"] = t_re
+        out[f"{name}_iterations_cold"] = int(sol.info.get("iterations", 0))
+        out[f"{name}_R_eq"] = sol.equivalent_resistance("top", "bottom")
+        out[f"{name}_residual"] = sol.residual
+
+    O.dt = 0.5 * yade.utils.PWaveTimeStep()
+    O.step()
+    out["yade_step_ms"], _ = best(O.step, repeat)
+    for k in list(out):
+        if k.endswith("_ms"):
+            out[k] = round(out[k] * 1e3, 3)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", default="5000,20000")
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    results = [bench_size(int(n), args.repeat) for n in args.sizes.split(",")]
+    keys = [k for k in results[0] if k != "n"]
+    print(f"{'':34s}" + "".join(f"{r['n']:>14d}" for r in results))
+    for k in keys:
+        print(f"{k:34s}" + "".join(f"{r[k]:>14.4g}" if isinstance(r[k], float) else f"{r[k]:>14}" for r in results))
+    print(json.dumps({"bench": "electro", "results": results}))
+
+
+if __name__ == "__main__":
+    main()

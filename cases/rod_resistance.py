@@ -1,0 +1,224 @@
+"""Rod equivalent resistance (paper 000, section 3.1, Table III and figure 7).
+
+A rod of radius R = 1 mm and length L = 5 mm (axis z, from z = 0 to z = L), steel 304L
+(rho_e = 0.73e-6 ohm m), is filled with N bonded elements; 1 V is applied between its two
+end electrodes; the DEM equivalent resistance R_dem is compared with
+
+    R_th = rho_e (L - 2 r_mean) / (pi R^2)
+
+Electrode layers (precise definition)
+--------------------------------------
+The bottom electrode is every element whose sphere comes within ``gap * r_mean`` of the end
+face z = 0, i.e. z_i - r_i <= gap r_mean (default gap = 0.1); the top electrode likewise at
+z = L (L - z_i - r_i <= gap r_mean). The packing is dense against the container walls, so
+these are the elements that touch the end faces: their centres sit one radius (on average
+r_mean) from the face, which is why the theoretical length is L - 2 r_mean.
+
+Run
+---
+    yade -n -x cases/rod_resistance.py --n 5000 --seed 1         # one packing
+    yade -n -x cases/rod_resistance.py --sweep                     # Table III: 5 sizes x 3 seeds
+    yade-batch cases/rod_resistance.table cases/rod_resistance.py  # the same through yade-batch
+
+The script ends by printing one line of JSON with its figures. It is also importable
+(``run_rod``) by the tests.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
+    sys.path.insert(0, os.path.dirname(HERE))
+
+from yade_electro.yade.runtime import import_yade  # noqa: E402
+
+RADIUS = 1e-3          # m
+LENGTH = 5e-3          # m
+RHO_304L = 0.73e-6     # ohm m
+SIZES = (1000, 2000, 5000, 10000, 20000)
+SEEDS = (1, 2, 3)
+#: Paper 000, Table III: (N, r_mean [um], errors [%] of the three generations)
+PAPER_TABLE_III = {1000: (133, (6.08, 10.51, 9.19)), 2000: (106, (12.28, 12.57, 15.56)),
+                   5000: (78, (4.11, 5.80, 4.04)), 10000: (62, (4.41, 3.60, 3.31)),
+                   20000: (49, (2.60, 2.92, 3.04))}
+
+
+def theoretical_resistance(r_mean: float, rho=RHO_304L, radius=RADIUS, length=LENGTH) -> float:
+    """R_th = rho (L - 2 r_mean) / (pi R^2) [ohm]."""
+    return rho * (length - 2.0 * r_mean) / (math.pi * radius ** 2)
+
+
+def end_layers(z, r, r_mean, gap=0.1, length=LENGTH):
+    """Masks of the bottom and top electrode layers (see module doc)."""
+    bottom = (z - r) <= gap * r_mean
+    top = (length - z - r) <= gap * r_mean
+    return bottom, top
+
+
+def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_params=None, solver="cg",
+            gap=0.1, detection_factor=None, cache_dir=None, history=None):
+    """Build (or load from the cache) the bonded rod in YADE, solve it with the electrical
+    engine, and return a dict of figures (n, r_mean, R_dem, R_th, error_pct, packing stats,
+    timings). Resets YADE's scene first."""
+    yade = import_yade()
+    from yade import pack
+    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import packing as P
+
+    O = yade.Omega()
+    O.reset()
+    t0 = time.perf_counter()
+    container = pack.inCylinder((0, 0, 0), (0, 0, LENGTH), RADIUS)
+    packing = P.dense_packing(container, n=n, seed=seed, cache_dir=cache_dir)
+    t_pack = time.perf_counter() - t0
+    kw = {} if detection_factor is None else {"detection_factor": detection_factor}
+    ids = P.add_bonded_packing(packing, **kw)
+    r_mean = float(np.mean(packing.radii))
+    z, r = packing.centers[:, 2], packing.radii
+    bottom, top = end_layers(z, r, r_mean, gap)
+    ids = np.asarray(ids)
+    engine = ElectricalEngine(rho, {"top": dict(select=ids[top], potential=voltage),
+                                    "bottom": dict(select=ids[bottom], potential=0.0)},
+                              law=law, law_params=law_params, solver=solver, iterPeriod=1,
+                              history=history, label="rod")
+    O.engines = O.engines + [engine.runner]
+    t1 = time.perf_counter()
+    O.step()
+    t_solve = time.perf_counter() - t1
+    g = engine.graph
+    from yade_electro.surfaces import eccentricity
+    e = eccentricity(g)
+    R_dem = engine.equivalent_resistance
+    R_th = theoretical_resistance(r_mean, rho)
+    sol = engine.solution
+    engine.remove()
+    return {
+        "case": "rod_resistance", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed), "law": law,
+        "r_mean": r_mean, "R_dem": float(R_dem), "R_th": float(R_th),
+        "error_pct": float(100.0 * (R_dem - R_th) / R_th),
+        "volume_fraction": float(np.sum(4.0 / 3.0 * np.pi * r ** 3) / (math.pi * RADIUS ** 2 * LENGTH)),
+        "mean_coordination": float(np.mean(g.degree)),
+        "frac_e_below_0.4": float(np.mean(e < 0.4)),
+        "n_bottom": int(bottom.sum()), "n_top": int(top.sum()),
+        "current_imbalance": float(sol.current_imbalance), "residual": float(sol.residual),
+        "t_packing_s": t_pack, "t_step_s": t_solve,
+    }
+
+
+def sweep(sizes=SIZES, seeds=SEEDS, out_dir="out/rod_resistance", law="continuum", **kw):
+    """Table III: every size x seed; writes a CSV and a PNG like figure 7; returns the rows."""
+    os.makedirs(out_dir, exist_ok=True)
+    rows = []
+    csv_path = os.path.join(out_dir, f"rod_resistance_{law}.csv")
+    import csv
+    with open(csv_path, "w", newline="") as fh:
+        w = None
+        for n in sizes:
+            for s in seeds:
+                row = run_rod(n, s, law=law, **kw)
+                rows.append(row)
+                if w is None:
+                    w = csv.DictWriter(fh, fieldnames=list(row))
+                    w.writeheader()
+                w.writerow(row)
+                fh.flush()
+                print(f"N={n:6d} seed={s} n={row['n']:6d} r_mean={row['r_mean'] * 1e6:6.1f} um "
+                      f"R_dem={row['R_dem'] * 1e3:.4f} mohm R_th={row['R_th'] * 1e3:.4f} mohm "
+                      f"error={row['error_pct']:+.2f} %", flush=True)
+    plot_sweep(rows, os.path.join(out_dir, f"rod_resistance_{law}.png"))
+    return rows
+
+
+def table_markdown(rows) -> str:
+    """Markdown table like the paper's Table III (ours next to the paper's)."""
+    by_n = {}
+    for r in rows:
+        by_n.setdefault(r["n_target"], []).append(r)
+    lines = ["| N | r_mean (um) | error 1 (%) | error 2 (%) | error 3 (%) | mean (%) | paper r_mean | paper errors (%) |",
+             "|---|---|---|---|---|---|---|---|"]
+    for n in sorted(by_n):
+        rs = sorted(by_n[n], key=lambda r: r["seed"])
+        errs = [r["error_pct"] for r in rs]
+        pr, pe = PAPER_TABLE_III.get(n, (float("nan"), ()))
+        lines.append(f"| {n} | {np.mean([r['r_mean'] for r in rs]) * 1e6:.0f} | "
+                     + " | ".join(f"{e:+.2f}" for e in errs) + " | " * (3 - len(errs))
+                     + f" | {np.mean(errs):+.2f} | {pr} | {', '.join(f'{x:.2f}' for x in pe)} |")
+    return "\n".join(lines)
+
+
+def plot_sweep(rows, path):
+    """Error versus element count (figure 7 of the paper), ours and the paper's."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4))
+    n = np.array([r["n"] for r in rows])
+    err = np.array([r["error_pct"] for r in rows])
+    ax.plot(n, err, "o", label="yade-electro (each packing)")
+    ns = sorted({r["n_target"] for r in rows})
+    ax.plot(ns, [np.mean([r["error_pct"] for r in rows if r["n_target"] == k]) for k in ns], "-",
+            label="yade-electro (mean of 3)")
+    pn = sorted(PAPER_TABLE_III)
+    ax.plot(pn, [np.mean(PAPER_TABLE_III[k][1]) for k in pn], "s--", label="paper 000, Table III (|error|)")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_xscale("log")
+    ax.set_xlabel("number of elements")
+    ax.set_ylabel("(R_dem - R_th) / R_th  [%]")
+    ax.set_title("Rod R = 1 mm, L = 5 mm: equivalent resistance")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _params(argv):
+    """Parameters from a yade-batch table (PARAM_TABLE set) or from the command line."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=5000)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--law", default="continuum")
+    ap.add_argument("--solver", default="cg")
+    ap.add_argument("--gap", type=float, default=0.1)
+    ap.add_argument("--sweep", action="store_true", help="all sizes x 3 seeds (Table III)")
+    ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
+    ap.add_argument("--out", default="out/rod_resistance")
+    args = ap.parse_args(argv)
+    if os.environ.get("PARAM_TABLE"):
+        from yade import utils
+        utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.law, noTableOk=True)
+        from yade.params import table
+        args.n, args.seed, args.law = int(table.n), int(table.seed), str(table.law)
+    return args
+
+
+def main(argv=None):
+    args = _params(sys.argv[1:] if argv is None else argv)
+    if args.sweep:
+        rows = sweep(args.sizes, SEEDS, args.out, law=args.law, solver=args.solver, gap=args.gap)
+        print(table_markdown(rows))
+        summary = {"case": "rod_resistance", "law": args.law, "rows": [
+            {k: r[k] for k in ("n", "n_target", "seed", "r_mean", "R_dem", "R_th", "error_pct")} for r in rows]}
+        for n in sorted({r["n_target"] for r in rows}):
+            summary[f"mean_error_pct_{n}"] = float(np.mean([r["error_pct"] for r in rows if r["n_target"] == n]))
+        print(json.dumps(summary))
+        return summary
+    os.makedirs(args.out, exist_ok=True)
+    row = run_rod(args.n, args.seed, law=args.law, solver=args.solver, gap=args.gap,
+                  history=os.path.join(args.out, f"history_n{args.n}_s{args.seed}.csv"))
+    with open(os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}.json"), "w") as fh:
+        json.dump(row, fh)
+    plot_sweep([row], os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}.png"))
+    print(json.dumps(row))
+    return row
+
+
+if __name__ == "__main__":
+    main()
