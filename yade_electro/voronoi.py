@@ -42,6 +42,16 @@ def ghost_points(pos, radius, container=None, band=None, neighbour_barycentre=No
         nrm = np.asarray(container.gradient(pos[near]), float)
         nrm /= np.linalg.norm(nrm, axis=1)[:, None]
         foot = pos[near] - d[near, None] * nrm                 # nearest surface point
+        ghost = 2.0 * foot - pos[near]
+        # a ghost is kept only where its mirror plane is a supporting plane of the solid:
+        # its foot is on the surface and it is (at least) as far outside as the element is
+        # inside. Elsewhere (edges and corners where the normal is ambiguous, concave
+        # parts) the cell is left open there and its faces are clipped instead.
+        tol = 1e-6 * radius[near]
+        good = (np.abs(np.asarray(container.sdf(foot), float)) <= tol + 1e-6 * np.abs(d[near])) & \
+               (np.asarray(container.sdf(ghost), float) >= -d[near] * (1.0 - 1e-6) - tol) & \
+               (-d[near] > tol)                                  # not on the surface itself
+        near, nrm, foot = near[good], nrm[good], foot[good]
     else:
         if neighbour_barycentre is None:
             raise ValueError("without a container, give neighbour_barycentre "

@@ -1,0 +1,112 @@
+"""The 'voronoi' conductance law: exact for uniform fields, cut by cracks."""
+import numpy as np
+import pytest
+
+from yade_electro import ContactGraph, conductance
+from yade_electro.conductance import network_graph
+from yade_electro.engine import ElectricalModel
+from yade_electro.network import equivalent_resistance
+from yade_electro.voronoi import VoronoiFaces, voronoi_faces
+
+
+class Box:
+    """Axis-aligned box with an exact signed distance (negative inside) and its gradient."""
+
+    def __init__(self, lo, hi):
+        self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
+
+    def sdf(self, x):
+        x = np.atleast_2d(x)
+        q = np.maximum(self.lo - x, x - self.hi)
+        out = np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(axis=1), 0)
+        return out
+
+    def gradient(self, x):
+        x = np.atleast_2d(x)
+        h = 1e-9 * float(np.max(self.hi - self.lo))
+        g = np.stack([(self.sdf(x + h * e) - self.sdf(x - h * e)) / (2 * h) for e in np.eye(3)], axis=1)
+        return g / np.linalg.norm(g, axis=1)[:, None]
+
+
+def test_cubic_lattice_faces_are_the_cube_faces():
+    r = 1.0
+    g = np.stack(np.meshgrid(*[np.arange(4)] * 3, indexing="ij"), -1).reshape(-1, 3) * 2 * r + r
+    box = Box([0, 0, 0], [8, 8, 8])
+    pairs, area = voronoi_faces(g, np.full(len(g), r), box)
+    d = np.linalg.norm(g[pairs[:, 0]] - g[pairs[:, 1]], axis=1)
+    face = np.isclose(d, 2 * r)
+    np.testing.assert_allclose(area[face], 4 * r * r, rtol=1e-9)
+    assert np.all(area[~face] < 1e-9 * r * r)   # diagonal pairs share at most an edge
+
+
+def test_uniform_field_is_exact_on_random_points():
+    """Random interior points, electrode points on the two end faces (dense enough that the
+    electrode cells cover the end faces): a uniform field satisfies Kirchhoff exactly, so
+    R_eq = rho L / A to rounding."""
+    rng = np.random.default_rng(3)
+    L, W, rho = 3.0, 1.0, 2.5
+    inner = rng.uniform([0.05, 0.05, 0.1], [W - 0.05, W - 0.05, L - 0.1], size=(400, 3))
+    gx = (np.stack(np.meshgrid(np.linspace(0.04, W - 0.04, 12), np.linspace(0.04, W - 0.04, 12),
+                               indexing="ij"), -1).reshape(-1, 2))
+    bottom = np.column_stack([gx, np.zeros(len(gx))])
+    top = np.column_stack([gx, np.full(len(gx), L)])
+    pos = np.concatenate([inner, bottom, top])
+    radius = np.full(len(pos), 0.05)
+    box = Box([0, 0, 0], [W, W, L])
+    pairs, area = voronoi_faces(pos, radius, box)
+    graph = ContactGraph(pos, radius, pairs)
+    c = conductance(graph, rho, "voronoi", container=box, hops=1)
+    n_in = len(inner)
+    bot = np.arange(n_in, n_in + len(gx))
+    topn = np.arange(n_in + len(gx), len(pos))
+    R = equivalent_resistance(graph.n_nodes, graph.edges, c, topn, bot, solver="direct")
+    assert R == pytest.approx(rho * L / (W * W), rel=1e-9)
+
+
+def _rod_graph(seed=0, n=1500):
+    rng = np.random.default_rng(seed)
+    L = 4.0
+    pos = rng.uniform([0, 0, 0], [1, 1, L], size=(n, 3))
+    radius = np.full(n, 0.08)
+    from scipy.spatial import cKDTree
+    pairs = cKDTree(pos).query_pairs(0.25, output_type="ndarray")
+    return ContactGraph(pos, radius, pairs), Box([0, 0, 0], [1, 1, L]), L
+
+
+def test_cut_bonds_cut_the_current():
+    graph, box, L = _rod_graph()
+    z = graph.pos[:, 2]
+    el = {"top": dict(select=z > L - 0.2, potential=1.0), "bottom": dict(select=z < 0.2, potential=0.0)}
+    m = ElectricalModel(1.0, el, law="voronoi", law_params=dict(container=box))
+    m.solve(graph)
+    assert np.isfinite(m.equivalent_resistance)
+    # break every bond crossing the plane z = L/2: no path of bonds crosses it any more
+    e = graph.edges
+    crossing = (z[e[:, 0]] < L / 2) != (z[e[:, 1]] < L / 2)
+    cut = graph.subgraph(~crossing)
+    m.solve(cut)
+    assert m.equivalent_resistance == float("inf")
+    assert not np.any(np.isnan(m.solution.potential))
+
+
+def test_hops_widen_the_network_and_faces_are_reused():
+    graph, box, L = _rod_graph(1)
+    cache = {}
+    n1 = network_graph(graph, "voronoi", container=box, cache=cache, hops=1)
+    faces = cache["faces"]
+    n3 = network_graph(graph, "voronoi", container=box, cache=cache, hops=3)
+    assert cache["faces"] is faces           # the tessellation is made once
+    assert n3.n_edges >= n1.n_edges
+    np.testing.assert_array_equal(n1.edges, np.unique(np.sort(graph.edges, axis=1), axis=0))
+
+
+def test_voronoi_needs_a_container():
+    graph, box, L = _rod_graph(2, n=200)
+    with pytest.raises(ValueError, match="container"):
+        conductance(graph, 1.0, "voronoi")
+
+
+def test_area_lookup_of_non_neighbours_is_zero():
+    pairs = np.array([[0, 1], [1, 2]])
+    f = VoronoiFaces(pairs, np.array([2.0, 3.0]), 4)
+    np.testing.assert_array_equal(f.area_of(np.array([[1, 0], [2, 1], [0, 3]])), [2.0, 3.0, 0.0])
