@@ -25,7 +25,7 @@ import numpy as np
 from .conductance import _law, check_resistivity, conductance, network_graph
 from .errors import BoundaryConditionError
 from .graph import ContactGraph
-from .network import ConductionProblem, Electrode, PotentialSolution
+from .network import ConductionProblem, Electrode, PotentialSolution, make_solver
 
 __all__ = ["ElectrodeSpec", "ElectricalModel", "History", "select_nodes"]
 
@@ -175,6 +175,9 @@ class ElectricalModel:
         names = [s.name for s in self.specs]
         if len(set(names)) != len(names):
             raise BoundaryConditionError(f"electrode names must be unique, got {names}")
+        _law(law)                      # unknown names fail here, not at the first solve
+        if isinstance(solver, str):
+            make_solver(solver)
         self.law = law
         self.law_params = dict(law_params or {})
         self.solver = solver

@@ -370,9 +370,10 @@ class ConductionProblem:
             raise BoundaryConditionError(f"electrode names must be unique, got {names}")
         owner = np.full(n, -1, dtype=np.int64)
         for k, e in enumerate(self.electrodes):
-            if e.nodes.max() >= n:
-                raise BoundaryConditionError(f"electrode {e.name!r} names node {e.nodes.max()} but the "
-                                             f"network has {n} nodes")
+            outside = e.nodes[(e.nodes < 0) | (e.nodes >= n)]
+            if outside.size:
+                raise BoundaryConditionError(f"electrode {e.name!r} names node {outside[-1]} but the "
+                                             f"network has {n} nodes (indices 0..{n - 1})")
             clash = e.nodes[owner[e.nodes] >= 0]
             if clash.size:
                 other = self.electrodes[owner[clash[0]]].name

@@ -75,7 +75,7 @@ class ElectricalEngine:
         Steps between two solves (the PyRunner's period).
     history : str, optional
         CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
-    bonds, mask, geometry_every, move_tolerance : see ``SceneReader``
+    bonds, mask, geometry_every, move_tolerance, full_read_every : see ``SceneReader``
     write_back : str or None
         Body attribute that receives each element's potential [V] (default 'potential');
         None to skip.
@@ -87,13 +87,13 @@ class ElectricalEngine:
 
     def __init__(self, resistivity, electrodes, law="continuum", law_params=None, solver="cg",
                  measure=None, iterPeriod: int = 1, history: Optional[str] = None, bonds="cohesive",
-                 mask=None, geometry_every: int = 1, move_tolerance: float = 1e-4,
+                 mask=None, geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0,
                  write_back: Optional[str] = "potential", plot: bool = False, label: str = "electro",
                  O=None):
         yade = import_yade()
         self.O = O if O is not None else yade.Omega()
         self.reader = SceneReader(self.O, bonds=bonds, mask=mask, geometry_every=geometry_every,
-                                  move_tolerance=move_tolerance)
+                                  move_tolerance=move_tolerance, full_read_every=full_read_every)
         specs = []
         for name, spec in dict(electrodes).items():
             spec = dict(spec)
@@ -107,6 +107,10 @@ class ElectricalEngine:
         self.label = label
         self.values: Dict[str, float] = {}
         ENGINES[label] = self
+        # fail in the user's script, with the real exception type, rather than later inside
+        # O.run() where YADE reports every PyRunner failure as "RuntimeError: PyRunner error."
+        if any(b is not None and isinstance(b.shape, yade.Sphere) for b in self.O.bodies):
+            self.model.prepare(self.reader.read())
         self.runner = yade.PyRunner(
             command=f"__import__('yade_electro.yade.engines', fromlist=['get_engine']).get_engine({label!r}).step()",
             iterPeriod=int(iterPeriod), label=label)

@@ -64,10 +64,15 @@ class SceneReader:
         Re-read positions every so many calls (0 = never after the first read).
     move_tolerance : float
         Relative displacement (in radii) above which new positions make a new graph.
+    full_read_every : int
+        Also read everything every so many calls (0 = only when a change is seen). The cheap
+        check cannot see an interaction that *becomes* a bond while the number of real
+        interactions stays the same (re-bonding by ``setCohesionNow`` during a run); set
+        this when a simulation does that.
     """
 
     def __init__(self, O=None, bonds: str = "cohesive", mask: Optional[int] = None,
-                 geometry_every: int = 1, move_tolerance: float = 1e-4):
+                 geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0):
         if bonds not in ("cohesive", "contacts"):
             raise ValueError(f"bonds must be 'cohesive' or 'contacts', got {bonds!r}")
         if O is None:
@@ -77,6 +82,7 @@ class SceneReader:
         self.mask = mask
         self.geometry_every = int(geometry_every)
         self.move_tolerance = float(move_tolerance)
+        self.full_read_every = int(full_read_every)
         self.graph: Optional[ContactGraph] = None
         self.ignored: Counter = Counter()
         self.full_reads = 0
@@ -91,7 +97,8 @@ class SceneReader:
     def read(self) -> ContactGraph:
         """The current graph: the kept one if nothing changed, else a new revision."""
         self.calls += 1
-        if self.graph is None or self._changed():
+        periodic = self.full_read_every and self.calls % self.full_read_every == 0
+        if self.graph is None or periodic or self._changed():
             self._full_read()
         elif self.geometry_every and self.calls % self.geometry_every == 0:
             self._refresh_geometry()

@@ -1,0 +1,295 @@
+"""ElectricalModel (electrodes by selector, kept problem, summary), select_nodes and the CSV
+History, on lattices where the answer is known."""
+import csv
+
+import numpy as np
+import pytest
+
+from yade_electro import BoundaryConditionError, MaterialError, conductance, equivalent_resistance
+from yade_electro.engine import ElectricalModel, ElectrodeSpec, History, select_nodes
+from yade_electro.network import CGSolver
+
+from lattice import cubic_lattice
+
+R, RHO = 0.5e-3, 0.73e-6
+SHAPE = (3, 3, 8)
+LAYER = SHAPE[0] * SHAPE[1]
+Z_TOP = 2 * R * (SHAPE[2] - 1)
+
+
+def bottom(pos, radius):
+    return pos[:, 2] < R
+
+
+def top(pos, radius):
+    return pos[:, 2] > Z_TOP - R
+
+
+def rod():
+    return cubic_lattice(SHAPE, r=R)
+
+
+def reference_resistance(graph, rho=RHO):
+    """The core computation on the same graph: end layers at 1 V / 0 V, direct solver."""
+    return equivalent_resistance(graph.n_nodes, graph.edges, conductance(graph, rho),
+                                 np.flatnonzero(top(graph.pos, None)), np.flatnonzero(bottom(graph.pos, None)),
+                                 solver="direct")
+
+
+def model(**kw):
+    electrodes = kw.pop("electrodes", {"top": dict(select=top, potential=1.0),
+                                       "bottom": dict(select=bottom, potential=0.0)})
+    return ElectricalModel(kw.pop("resistivity", RHO), electrodes, **kw)
+
+
+# -- results ------------------------------------------------------------------------------------
+@pytest.mark.parametrize("solver", ["cg", "direct"])
+def test_model_matches_the_core_computation(solver):
+    g = rod()
+    m = model(solver=solver)
+    sol = m.solve(g)
+    R_ref = reference_resistance(g)
+    assert m.measure == ("top", "bottom")
+    assert m.equivalent_resistance == pytest.approx(R_ref, rel=1e-9)
+    assert sol.electrode_current["top"] == pytest.approx(1.0 / R_ref, rel=1e-9)
+    assert m.graph is g and m.rebuilds == 1
+    np.testing.assert_array_equal(m.conductance, conductance(g, RHO))
+    row = m.summary()
+    assert row["R_eq"] == m.equivalent_resistance
+    assert (row["V_top"], row["V_bottom"]) == (1.0, 0.0)
+    assert row["I_top"] == pytest.approx(-row["I_bottom"], rel=1e-9)
+    assert row["joule_power"] == pytest.approx(1.0 * row["I_top"], rel=1e-9)     # V I = sum w^2 / c
+    assert (row["n_nodes"], row["n_edges"], row["n_floating"]) == (g.n_nodes, g.n_edges, 0)
+    assert row["residual"] <= 1e-10 and row["current_imbalance"] <= 1e-9
+    assert set(row) == {"R_eq", "V_top", "I_top", "V_bottom", "I_bottom", "joule_power", "n_nodes", "n_edges",
+                        "n_floating", "residual", "current_imbalance", "iterations", "solve_time"}
+
+
+def test_selectors_ids_mask_and_callable_agree():
+    g = cubic_lattice(SHAPE, r=R, ids=np.arange(SHAPE[0] * SHAPE[1] * SHAPE[2]) * 3 + 100)
+    top_mask, bottom_mask = top(g.pos, g.radius), bottom(g.pos, g.radius)
+    results = []
+    for sel_top, sel_bottom in [(top, bottom), (top_mask, bottom_mask),
+                                (g.ids[top_mask].tolist(), g.ids[bottom_mask])]:
+        m = model(electrodes={"top": dict(select=sel_top, potential=1.0),
+                              "bottom": dict(select=sel_bottom, potential=0.0)}, solver="direct")
+        m.solve(g)
+        np.testing.assert_array_equal(m.problem.electrodes[0].nodes, np.flatnonzero(top_mask))
+        results.append(m.equivalent_resistance)
+    assert results[0] == results[1] == results[2]
+    np.testing.assert_array_equal(select_nodes(g, g.ids[[5, 2]]), [5, 2])
+
+
+def test_electrode_specs_and_measure():
+    g = rod()
+    specs = [ElectrodeSpec("mid", lambda p, r: np.isclose(p[:, 2], 2 * R * 3), potential=0.25),
+             ElectrodeSpec("top", top, potential=1.0), ElectrodeSpec("bottom", bottom, potential=0.0)]
+    m = ElectricalModel(RHO, specs, solver="direct", measure=("top", "bottom"))
+    sol = m.solve(g)
+    # R_eq(top, bottom) = (1 - 0) / I_top with the middle layer held at 0.25 V
+    assert m.equivalent_resistance == pytest.approx(1.0 / sol.electrode_current["top"], rel=1e-12)
+    assert ElectricalModel(RHO, specs).measure == ("mid", "top")
+    assert ElectricalModel(RHO, specs[:1]).measure is None
+
+
+def test_imposed_current_through_the_model():
+    g = rod()
+    I = 3.0e-3
+    m = model(electrodes={"top": dict(select=top, current=I), "bottom": dict(select=bottom, potential=0.0)},
+              solver="direct")
+    sol = m.solve(g)
+    assert sol.electrode_potential["top"] == pytest.approx(I * reference_resistance(g), rel=1e-10)
+    assert m.equivalent_resistance == pytest.approx(reference_resistance(g), rel=1e-10)
+
+
+# -- what is kept between solves ------------------------------------------------------------------
+def test_same_graph_keeps_the_problem_and_the_setup():
+    g = rod()
+    m = model(solver="cg")
+    s1 = m.solve(g)
+    problem = m.problem
+    s2 = m.solve(g)
+    assert m.problem is problem and m.rebuilds == 1
+    assert s1.info["setup"] is True and s2.info["setup"] is False and s2.info["iterations"] == 0
+    np.testing.assert_array_equal(s2.potential, s1.potential)
+    # new electrode values: same problem, linear response
+    s3 = m.solve(g, {"top": 2.0})
+    assert m.rebuilds == 1 and s3.info["setup"] is False
+    assert s3.electrode_potential["top"] == 2.0
+    np.testing.assert_allclose(s3.potential, 2 * s1.potential, rtol=0, atol=1e-9)
+
+
+def test_new_graph_revision_rebuilds():
+    g = rod()
+    m = model(solver="direct")
+    m.solve(g)
+    R0 = m.equivalent_resistance
+    # cut every bond between layers 3 and 4: the rod is open
+    z = g.pos[:, 2]
+    cut = np.isclose(z[g.edges[:, 0]], 2 * R * 3) & np.isclose(z[g.edges[:, 1]], 2 * R * 4)
+    assert cut.sum() == LAYER
+    broken = g.subgraph(~cut)
+    assert broken.revision == g.revision + 1
+    sol = m.solve(broken)
+    assert m.rebuilds == 2 and m.graph is broken
+    assert m.equivalent_resistance == np.inf
+    assert np.all(np.isfinite(sol.potential)) and not np.any(np.isnan(sol.branch_current))
+    row = m.summary()
+    assert row["R_eq"] == np.inf and abs(row["joule_power"]) < 1e-20   # rounding only
+    # back to an intact graph
+    m.solve(g.with_edges(g.edges))
+    assert m.rebuilds == 3 and m.equivalent_resistance == pytest.approx(R0, rel=1e-12)
+
+
+def test_set_resistivity_rebuilds_and_scales():
+    g = rod()
+    m = model(solver="direct")
+    m.solve(g)
+    R0 = m.equivalent_resistance
+    m.set_resistivity(2 * RHO)
+    m.solve(g)
+    assert m.rebuilds == 2
+    assert m.equivalent_resistance == pytest.approx(2 * R0, rel=1e-12)
+    # per-node resistivity: uniform values give the scalar answer
+    m.set_resistivity(np.full(g.n_nodes, RHO))
+    m.solve(g)
+    assert m.equivalent_resistance == pytest.approx(R0, rel=1e-12)
+
+
+def test_solver_object_is_kept_across_rebuilds():
+    g = rod()
+    solver = CGSolver(rtol=1e-12)
+    m = model(solver=solver)
+    m.solve(g)
+    m.solve(g.with_edges(g.edges))
+    assert m.problem.solver is solver and m.rebuilds == 2
+    assert m.equivalent_resistance == pytest.approx(reference_resistance(g), rel=1e-10)
+
+
+def test_floating_cluster_in_the_model():
+    g = rod()
+    # detach node (0, 0, 3), on a side edge of the rod, by removing its 4 bonds
+    node = 3 * LAYER + 0
+    keep = ~np.any(g.edges == node, axis=1)
+    assert (~keep).sum() == 4
+    with pytest.warns(UserWarning, match=r"1 element\(s\) in 1 cluster\(s\)"):
+        sol = model(solver="direct").solve(g.subgraph(keep))
+    assert sol.floating.sum() == 1 and sol.floating[node] and sol.potential[node] == 0.0
+
+
+# -- bad input ------------------------------------------------------------------------------
+@pytest.mark.parametrize("rho", [0.0, -1.0, np.nan])
+def test_bad_resistivity(rho):
+    with pytest.raises(MaterialError, match="resistivity must be finite and > 0"):
+        model(resistivity=rho)
+    m = model()
+    m.set_resistivity(rho)
+    with pytest.raises(MaterialError, match="resistivity must be finite and > 0"):
+        m.solve(rod())
+
+
+def test_electrode_selecting_nothing():
+    m = model(electrodes={"top": dict(select=lambda p, r: p[:, 2] > 1.0, potential=1.0),
+                          "bottom": dict(select=bottom, potential=0.0)})
+    with pytest.raises(BoundaryConditionError, match="electrode 'top' selects no element"):
+        m.solve(rod())
+    for empty in ([], np.zeros(rod().n_nodes, dtype=bool)):
+        with pytest.raises(BoundaryConditionError, match="electrode 'e' selects no element"):
+            select_nodes(rod(), empty, "e")
+
+
+def test_bad_selectors():
+    g = rod()
+    with pytest.raises(BoundaryConditionError, match=r"electrode 'e': ids not in the graph: \[9999\]"):
+        select_nodes(g, [0, 9999], "e")
+    with pytest.raises(BoundaryConditionError, match=r"electrode 'e': mask has shape \(3,\), the graph has 72"):
+        select_nodes(g, np.array([True, False, True]), "e")
+    with pytest.raises(BoundaryConditionError, match=r"electrode 'e': the selector returned shape \(\)"):
+        select_nodes(g, lambda p, r: True, "e")
+
+
+def test_same_body_in_two_electrodes():
+    m = model(electrodes={"top": dict(select=top, potential=1.0),
+                          "all": dict(select=lambda p, r: np.ones(len(p), bool), potential=0.0)})
+    with pytest.raises(BoundaryConditionError, match="belong to both electrodes 'top' and 'all'"):
+        m.solve(rod())
+
+
+def test_model_construction_errors():
+    with pytest.raises(BoundaryConditionError, match="at least one electrode"):
+        ElectricalModel(RHO, {})
+    with pytest.raises(BoundaryConditionError, match="names must be unique"):
+        ElectricalModel(RHO, [ElectrodeSpec("a", top, potential=1.0), ElectrodeSpec("a", bottom, potential=0.0)])
+    with pytest.raises(BoundaryConditionError, match=r"measure=\('top', 'side'\) names an unknown electrode"):
+        model(measure=("top", "side"))
+    with pytest.raises(TypeError, match=r"electrode 'top': give a dict\(select=..."):
+        ElectricalModel(RHO, {"top": 1.0})
+    with pytest.raises(RuntimeError, match="no solution yet"):
+        model().equivalent_resistance
+    with pytest.raises(RuntimeError, match="no solution yet"):
+        model().summary()
+
+
+def test_unknown_law_and_solver():
+    # the names are checked at the first solve at the latest
+    with pytest.raises(KeyError, match="unknown conductance law 'ohm'; known laws: .*continuum"):
+        model(law="ohm").solve(rod())
+    with pytest.raises(ValueError, match="unknown solver 'lu'; known: cg, cg-amg, cg-jacobi, direct"):
+        model(solver="lu").solve(rod())
+
+
+# -- History ---------------------------------------------------------------------------------
+def read_csv(path):
+    with open(path, newline="") as fh:
+        return list(csv.reader(fh))
+
+
+def test_history_writes_the_csv_row_by_row(tmp_path):
+    path = tmp_path / "out" / "deep" / "history.csv"          # directories are created
+    h = History(str(path))
+    assert path.exists() and path.read_text() == ""
+    rows = [{"iter": 0, "R_eq": 1.0 / 3.0, "I": -2.5e-7},
+            {"iter": 10, "R_eq": float("inf"), "I": 0.1},
+            {"I": np.float64(1e-300), "iter": 20, "R_eq": 12.0}]      # key order does not matter
+    for k, row in enumerate(rows):
+        h.append(row)
+        lines = read_csv(path)
+        assert lines[0] == ["iter", "R_eq", "I"]
+        assert len(lines) == k + 2 and len(h) == k + 1
+        last = lines[-1]
+        assert int(last[0]) == row["iter"]
+        assert float(last[1]) == row["R_eq"] and float(last[2]) == row["I"]   # exact round trip
+    np.testing.assert_array_equal(h.column("iter"), [0, 10, 20])
+    df = h.to_dataframe()
+    assert list(df.columns) == ["iter", "R_eq", "I"] and len(df) == 3
+    assert df["R_eq"].iloc[0] == 1.0 / 3.0 and np.isinf(df["R_eq"].iloc[1])
+    with pytest.raises(ValueError, match="differ from the columns"):
+        h.append({"iter": 30, "R_eq": 1.0})
+    assert len(read_csv(path)) == 4                            # the bad row was not written
+
+
+def test_history_starts_a_fresh_file_and_can_stay_in_memory(tmp_path):
+    path = tmp_path / "h.csv"
+    path.write_text("old,content\n1,2\n")
+    h = History(str(path))
+    assert path.read_text() == ""
+    h.append({"a": 1.5})
+    assert read_csv(path) == [["a"], ["1.5"]]
+    mem = History()
+    mem.append({"a": 1.0})
+    assert len(mem) == 1 and mem.to_dataframe()["a"].tolist() == [1.0]
+    assert History().to_dataframe().empty
+
+
+def test_model_summary_goes_into_a_history(tmp_path):
+    g = rod()
+    m = model(solver="direct")
+    h = History(str(tmp_path / "h.csv"))
+    for v in (1.0, 2.0):
+        m.solve(g, {"top": v})
+        h.append(m.summary())
+    lines = read_csv(tmp_path / "h.csv")
+    assert len(lines) == 3 and lines[0][0] == "R_eq"
+    df = h.to_dataframe()
+    assert df["V_top"].tolist() == [1.0, 2.0]
+    assert df["R_eq"].iloc[0] == pytest.approx(df["R_eq"].iloc[1], rel=1e-12)
