@@ -1,0 +1,703 @@
+"""Heat capacities, Joule sources, thermal boundary conditions and time integrators.
+
+The lumped heat balance of a packing (paper 000 eq. 13 and 16, paper 003 eq. 14):
+
+    C_i dT_i/dt = P_i + sum_j G_ij (T_j - T_i) + h_i A_i (T_inf,i - T_i) + Q_i
+
+* ``C_i = rho c V_i / fv_i`` [J/K], the heat capacity of the volume the element stands for
+  (:func:`heat_capacity`);
+* ``P_i`` [W], half the Joule power ``eta w_ij^2 / c_ij`` of every bond of i
+  (:func:`joule_sources`);
+* ``G_ij = lambda S_ij / l_ij`` [W/K], the thermal conductance; any electrical conductance
+  law gives it when called with the thermal resistivity 1/lambda
+  (:func:`thermal_conductance`; the 'continuum' law gives exactly paper 000 eq. 16);
+* convection ``h A (T_inf - T)`` on free-surface elements and imposed heat inputs ``Q_i``
+  [W]; fixed-temperature node sets take the place of electrodes.
+
+In matrix form ``C dT/dt = -M T + s`` with ``M = K + diag(h A)`` (K the Laplacian of G) and
+``s = P + Q + h A T_inf``. :class:`HeatSolver` integrates it with the theta family (paper
+003): ``(C/dt + theta M) T^{n+1} = (C/dt - (1 - theta) M) T^n + s``, sources constant over
+the step; ``theta = 0`` is forward Euler (no solve), ``1/2`` Crank-Nicolson, ``1`` backward
+Euler. Fixed-temperature nodes are eliminated from the unknowns.
+
+Stability of the explicit scheme
+--------------------------------
+Forward Euler keeps every new temperature a convex combination of the old ones (so no
+oscillation and no growth) when ``dt <= dt_crit = min_i C_i / M_ii`` over the free nodes
+(:func:`stable_time_step`, the diagonal/Gershgorin bound; for two equal elements it is
+exactly the stability limit C/G). For ``theta < 1/2`` the bound is ``dt_crit / (1 - 2
+theta)``. A requested step above ``safety * bound`` is split into ``n_sub = ceil(dt /
+(safety * bound))`` equal sub-steps, or raises :class:`ThermalError` when sub-cycling is
+off. Paper 000 eq. 14 quotes ``l_min^2 / (2 alpha)``, alpha = lambda / (rho c)
+(:func:`diffusion_time_step`); it ignores the volume fractions, the surfaces and the
+number of neighbours (it is the 1D bound), so it is reported for comparison only: on a simple
+cubic lattice the lumped bound is about 4x smaller (interior elements C/sum G = (2/3) r^2 /
+alpha against the paper's 2 r^2 / alpha; edge and corner elements lower still), so a step
+taken from eq. 14 alone would be unstable. ``theta >= 1/2`` has no step limit; only ``theta = 1`` keeps
+the maximum principle at any step (Crank-Nicolson oscillates for steps far above dt_crit).
+
+Units: SI (kg/m^3, J/(kg K), W/(m K), W/(m^2 K), K or degC, J/K, W, s).
+"""
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+from typing import Any, Optional, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from .conductance import conductance
+from .errors import BoundaryConditionError, MaterialError, ThermalError
+from .graph import ContactGraph
+from .network import laplacian, make_solver
+from .surfaces import eccentricity, volume_fraction as _volume_fraction
+
+__all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
+           "exposed_area", "stable_time_step", "diffusion_time_step", "theta_of",
+           "FixedTemperature", "HeatFlux", "Convection", "ThermalState", "HeatStep", "HeatSolver"]
+
+log = logging.getLogger(__name__)
+
+_THETA_NAMES = {"explicit": 0.0, "forward-euler": 0.0, "crank-nicolson": 0.5,
+                "backward-euler": 1.0, "implicit": 1.0}
+
+
+# ---------------------------------------------------------------------------------------
+# material input
+# ---------------------------------------------------------------------------------------
+def _positive(name: str, value, n: Optional[int], unit: str = "") -> np.ndarray:
+    """``value`` as a float scalar or (n,) array, or MaterialError if not finite and > 0."""
+    a = np.asarray(value, dtype=float)
+    if a.ndim not in (0, 1) or (a.ndim == 1 and n is not None and a.shape[0] != n):
+        raise MaterialError(f"{name} must be a scalar or one value per element ({n}), got shape {a.shape}")
+    ok = np.isfinite(a) & (a > 0)
+    if not np.all(ok):
+        bad = a if a.ndim == 0 else a[~ok][:5]
+        raise MaterialError(f"{name} must be finite and > 0{unit}; got {np.atleast_1d(bad).tolist()}")
+    return a
+
+
+def heat_capacity(graph: ContactGraph, density, specific_heat, volume_fraction=None, cell_volume=None,
+                  threshold: float = 0.4, factor: float = 2.0) -> np.ndarray:
+    """Heat capacity C_i of every element [J/K].
+
+    ``C_i = rho c V_i / fv_i`` (paper 000 eq. 13), V_i the sphere volume and fv_i the volume
+    fraction of the continuum model (:func:`yade_electro.surfaces.volume_fraction`), so that
+    the element carries the heat capacity of the polyhedron it stands for.
+
+    Parameters
+    ----------
+    graph : ContactGraph
+    density : float or (n,) [kg/m^3], > 0
+    specific_heat : float or (n,) [J/(kg K)], > 0
+    volume_fraction : float or (n,), optional
+        Explicit fv_i (e.g. 1.0 for the paper's rod check); default from the bond graph.
+    cell_volume : (n,) array [m^3], optional
+        Volumes of the cells the elements stand for (e.g. Voronoi cells); then
+        ``C_i = rho c V_cell_i`` and ``volume_fraction`` must not be given.
+    threshold, factor : eccentricity rule of the default volume fraction.
+
+    Raises
+    ------
+    MaterialError
+        A non-positive or non-finite density, specific heat, volume fraction or cell volume.
+    """
+    n = graph.n_nodes
+    rc = _positive("density", density, n, " (kg/m^3)") * _positive("specific_heat", specific_heat, n,
+                                                                      " (J/(kg K))")
+    if cell_volume is not None:
+        if volume_fraction is not None:
+            raise ValueError("give volume_fraction= or cell_volume=, not both")
+        v = _positive("cell_volume", cell_volume, n, " (m^3)")
+        return np.broadcast_to(rc * v, (n,)).astype(float)
+    if volume_fraction is None:
+        fv = _volume_fraction(graph, threshold=threshold, factor=factor)
+    else:
+        fv = _positive("volume_fraction", volume_fraction, n)
+    return np.broadcast_to(rc * graph.volume / fv, (n,)).astype(float)
+
+
+def thermal_conductance(graph: ContactGraph, conductivity, law: str = "continuum", **params) -> np.ndarray:
+    """Thermal conductance G_ij of every edge [W/K]: the electrical law ``law`` called with the
+    thermal resistivity 1/lambda. For 'continuum' it is ``lambda S_ij / l_ij`` (paper 000
+    eq. 16); per-node conductivities make an edge two half rods in series.
+
+    Raises
+    ------
+    MaterialError
+        A non-positive or non-finite conductivity [W/(m K)].
+    """
+    lam = _positive("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
+    return conductance(graph, 1.0 / lam, law, **params)
+
+
+def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_heat) -> float:
+    """Paper 000 eq. 14: ``l_min^2 / (2 alpha)`` [s], alpha = lambda / (rho c) (the largest
+    over the nodes when properties vary). For comparison with :func:`stable_time_step`,
+    which is the bound the integrators use."""
+    n = graph.n_nodes
+    alpha = (_positive("thermal conductivity", conductivity, n) /
+             (_positive("density", density, n) * _positive("specific_heat", specific_heat, n)))
+    if graph.n_edges == 0:
+        return math.inf
+    return float(np.min(graph.length) ** 2 / (2.0 * np.max(alpha)))
+
+
+# ---------------------------------------------------------------------------------------
+# Joule heating
+# ---------------------------------------------------------------------------------------
+def edge_joule_power(branch_current, conductance, eta: float = 1.0) -> np.ndarray:
+    """Heat released in every edge, ``eta u_ij w_ij = eta w_ij^2 / c_ij`` [W] (paper 000
+    eq. 11); 0 on edges of zero conductance (they carry no current)."""
+    if not (0.0 <= eta <= 1.0):
+        raise ValueError(f"eta (share of the electrical power released as heat) must be in [0, 1], got {eta}")
+    w = np.asarray(branch_current, dtype=float)
+    c = np.asarray(conductance, dtype=float)
+    if w.shape != c.shape or w.ndim != 1:
+        raise ValueError(f"branch_current and conductance must be (m,) arrays of one shape, got {w.shape} "
+                         f"and {c.shape}")
+    p = np.zeros_like(c)
+    nz = c > 0
+    p[nz] = eta * w[nz] ** 2 / c[nz]
+    return p
+
+
+def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float = 1.0) -> np.ndarray:
+    """Joule power received by every node [W]: each edge's ``eta w^2 / c`` shared half and half
+    by its two end nodes. The total equals ``eta * sum_e V_e I_e`` over the electrodes
+    (:func:`electrical_power`) when no current is injected elsewhere."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    p = edge_joule_power(branch_current, conductance, eta)
+    if p.shape[0] != edges.shape[0]:
+        raise ValueError(f"one branch current per edge expected ({edges.shape[0]}), got {p.shape[0]}")
+    return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
+
+
+def electrical_power(solution) -> float:
+    """``sum_e V_e I_e`` over the electrodes of a PotentialSolution [W]: the power the external
+    circuit delivers (Tellegen: equals the total Joule power of the network)."""
+    return float(sum(solution.electrode_potential[k] * solution.electrode_current[k]
+                     for k in solution.electrode_current))
+
+
+# ---------------------------------------------------------------------------------------
+# boundary conditions
+# ---------------------------------------------------------------------------------------
+def exposed_area(graph: ContactGraph, threshold: float = 0.4) -> np.ndarray:
+    """Default exposed (free-surface) area A_i of every element [m^2] for convection and
+    surface fluxes: ``pi r_i^2`` where the eccentricity e_i > ``threshold`` (the elements the
+    continuum model treats as on the surface, f_i = 2), 0 elsewhere.
+
+    This is a crude estimate (one great-circle disc per surface element; the face elements
+    of a simple cubic lattice, e = 0.4 exactly, count as interior). When the surface
+    exchange matters, pass the areas yourself (``area=`` of :class:`Convection` /
+    :class:`HeatFlux`), e.g. the boundary faces of the Voronoi cells.
+    """
+    e = eccentricity(graph)
+    return np.where(e > threshold * (1.0 + 1e-9), np.pi * graph.radius ** 2, 0.0)
+
+
+def _finite(name, v):
+    if v is None or not np.isfinite(v):
+        raise BoundaryConditionError(f"{name} must be a finite number, got {v}")
+    return float(v)
+
+
+@dataclass(frozen=True)
+class FixedTemperature:
+    """A node set held at ``temperature`` [K or degC, as the model].
+
+    ``nodes``: node indices (HeatSolver), or, when a graph is given
+    (``HeatSolver.from_graph``, ``ElectroThermalModel``), anything
+    ``yade_electro.engine.select_nodes`` takes (callable, mask, graph ids)."""
+
+    name: str
+    nodes: Any
+    temperature: float
+
+    def __post_init__(self):
+        _finite(f"fixed temperature {self.name!r}: temperature", self.temperature)
+
+
+@dataclass(frozen=True)
+class HeatFlux:
+    """Heat fed into a node set: ``power`` [W] in total, shared in proportion to ``area`` (equal
+    shares when ``area`` is None), or ``flux`` [W/m^2] times each node's ``area``. Negative
+    values extract heat.
+
+    ``area``: scalar (every node) or (n,) array over all nodes [m^2]; None = equal shares
+    (power) or :func:`exposed_area` (flux, needs a graph)."""
+
+    name: str
+    nodes: Any
+    power: Optional[float] = None
+    flux: Optional[float] = None
+    area: Any = None
+
+    def __post_init__(self):
+        if (self.power is None) == (self.flux is None):
+            raise BoundaryConditionError(f"heat flux {self.name!r}: give exactly one of power= (W, total) "
+                                         "or flux= (W/m^2)")
+        _finite(f"heat flux {self.name!r}: value", self.power if self.power is not None else self.flux)
+
+
+@dataclass(frozen=True)
+class Convection:
+    """Convection ``h A_i (t_inf - T_i)`` [W] on a node set: ``h`` [W/(m^2 K)] >= 0, ``t_inf`` the
+    ambient temperature, ``area`` scalar or (n,) [m^2] (None = :func:`exposed_area`)."""
+
+    name: str
+    nodes: Any
+    h: float
+    t_inf: float
+    area: Any = None
+
+    def __post_init__(self):
+        if not (np.isfinite(self.h) and self.h >= 0):
+            raise MaterialError(f"convection {self.name!r}: h must be finite and >= 0 (W/(m^2 K)), got {self.h}")
+        _finite(f"convection {self.name!r}: t_inf", self.t_inf)
+
+
+def _resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
+    if graph is not None:
+        from .engine import select_nodes  # local: engine is the higher layer
+        try:
+            return np.unique(select_nodes(graph, bc.nodes, bc.name))
+        except BoundaryConditionError as exc:
+            raise BoundaryConditionError(f"thermal boundary condition: {exc}") from None
+    if callable(bc.nodes):
+        raise BoundaryConditionError(f"{bc.name!r}: a selector needs a graph; give node indices or use "
+                                     "HeatSolver.from_graph")
+    a = np.asarray(bc.nodes)
+    if a.dtype == bool:
+        if a.shape != (n,):
+            raise BoundaryConditionError(f"{bc.name!r}: mask has shape {a.shape}, expected ({n},)")
+        nodes = np.flatnonzero(a)
+    else:
+        nodes = np.unique(a.astype(np.int64).reshape(-1))
+        if nodes.size and (nodes.min() < 0 or nodes.max() >= n):
+            raise BoundaryConditionError(f"{bc.name!r}: node index out of range 0..{n - 1}")
+    if nodes.size == 0:
+        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r} selects no element")
+    return nodes
+
+
+def _resolve_area(bc, nodes, n, default_area) -> np.ndarray:
+    if bc.area is None:
+        if default_area is None:
+            raise BoundaryConditionError(f"{bc.name!r}: no area given and no graph to estimate the exposed "
+                                         "area from; pass area= (m^2, scalar or per node)")
+        a = np.asarray(default_area, dtype=float)[nodes]
+    else:
+        a = np.asarray(bc.area, dtype=float)
+        if a.ndim == 0:
+            a = np.full(nodes.size, float(a))
+        elif a.shape == (n,):
+            a = a[nodes]
+        else:
+            raise BoundaryConditionError(f"{bc.name!r}: area must be a scalar or an ({n},) array, got {a.shape}")
+    if not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise BoundaryConditionError(f"{bc.name!r}: areas must be finite and >= 0")
+    return a
+
+
+# ---------------------------------------------------------------------------------------
+# stability
+# ---------------------------------------------------------------------------------------
+def stable_time_step(capacity, edges, conductance, h_area=None, fixed=None) -> float:
+    """Largest forward-Euler step keeping the maximum principle [s]:
+    ``min_i C_i / (sum_j G_ij + h_i A_i)`` over the free nodes (``fixed`` a boolean mask of
+    fixed-temperature nodes); inf when no free node exchanges heat."""
+    C = np.asarray(capacity, dtype=float)
+    n = C.shape[0]
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    g = np.asarray(conductance, dtype=float)
+    d = np.bincount(e[:, 0], g, n) + np.bincount(e[:, 1], g, n)
+    if h_area is not None:
+        d = d + np.asarray(h_area, dtype=float)
+    free = np.ones(n, bool) if fixed is None else ~np.asarray(fixed, bool)
+    sel = free & (d > 0)
+    return float(np.min(C[sel] / d[sel])) if np.any(sel) else math.inf
+
+
+def theta_of(theta) -> float:
+    """theta from a number in [0, 1] or a name ('explicit', 'crank-nicolson', 'backward-euler')."""
+    if isinstance(theta, str):
+        try:
+            return _THETA_NAMES[theta.lower()]
+        except KeyError:
+            raise ValueError(f"unknown integrator {theta!r}; known: {', '.join(sorted(_THETA_NAMES))} "
+                             "or a number in [0, 1]") from None
+    t = float(theta)
+    if not (0.0 <= t <= 1.0):
+        raise ValueError(f"theta must be in [0, 1], got {theta}")
+    return t
+
+
+# ---------------------------------------------------------------------------------------
+# results
+# ---------------------------------------------------------------------------------------
+def _ro(a):
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class ThermalState:
+    """Temperatures (n,) [K] at ``time`` [s] (a read-only copy)."""
+
+    temperature: np.ndarray
+    time: float
+
+
+@dataclass(frozen=True)
+class HeatStep:
+    """What one :meth:`HeatSolver.advance` did (energies in J over the step).
+
+    source_energy : the given sources (e.g. Joule) on free nodes, integrated over dt
+    absorbed_energy : given sources that fell on fixed-temperature nodes (taken by the thermostat)
+    flux_energy : imposed heat fluxes (HeatFlux)
+    convection_energy : heat received from the ambient by convection (negative when cooling)
+    boundary_energy : heat received from the fixed-temperature nodes
+    heat_change : sum_i C_i (T_i^{n+1} - T_i^n) over free nodes; equals the sum of the four
+        inputs above (to rounding) for every theta
+    """
+
+    time: float
+    dt: float
+    n_substeps: int
+    source_energy: float
+    absorbed_energy: float
+    flux_energy: float
+    convection_energy: float
+    boundary_energy: float
+    heat_change: float
+    info: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def balance_error(self) -> float:
+        """|heat_change - inputs| / max(|terms|): a check of the integration's energy balance."""
+        inputs = self.source_energy + self.flux_energy + self.convection_energy + self.boundary_energy
+        scale = max(abs(self.heat_change), abs(self.source_energy), abs(self.flux_energy),
+                    abs(self.convection_energy), abs(self.boundary_energy)) or 1.0
+        return abs(self.heat_change - inputs) / scale
+
+
+# ---------------------------------------------------------------------------------------
+# the integrator
+# ---------------------------------------------------------------------------------------
+class HeatSolver:
+    """Lumped heat conduction on a network, advanced step by step with the theta method.
+
+    Parameters
+    ----------
+    capacity : (n,) heat capacities C_i [J/K], > 0
+    edges : (m, 2) node indices
+    conductance : (m,) thermal conductances G_ij [W/K], >= 0
+    temperature : float or (n,) initial temperatures; fixed-temperature nodes take their value
+    fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
+    theta : float in [0, 1] or 'explicit' (0), 'crank-nicolson' (1/2), 'backward-euler' (1, default)
+    subcycle : bool
+        For theta < 1/2, split a step above the stable one into sub-steps (default) or raise.
+    safety : float in (0, 1]
+        Fraction of the stability bound used as the largest (sub-)step (default 0.9).
+    max_substeps : int
+        Refuse (ThermalError) a step that would need more explicit sub-steps than this.
+    solver : linear solver name or object for theta > 0 (default 'direct': sparse LU kept while
+        dt and the network do not change; 'cg' works too, the matrix is SPD)
+    time : initial time [s]
+    graph : ContactGraph, optional
+        Lets boundary conditions use selectors / graph ids and default exposed areas.
+    area : (n,) exposed areas [m^2], optional
+        Default areas of Convection/HeatFlux(flux=) (else :func:`exposed_area` of ``graph``).
+
+    Notes
+    -----
+    Sources given to :meth:`advance` are held constant over the step. Sources on
+    fixed-temperature nodes are taken by the thermostat (reported as ``absorbed_energy``);
+    convection does not act on fixed nodes. The state (temperatures, time) changes only when
+    a step succeeds: a non-finite source or result raises :class:`ThermalError` and leaves it
+    as it was.
+    """
+
+    def __init__(self, capacity, edges, conductance, temperature, *, fixed: Sequence[FixedTemperature] = (),
+                 flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), theta="backward-euler",
+                 subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="direct",
+                 time: float = 0.0, graph: Optional[ContactGraph] = None, area=None):
+        C = np.asarray(capacity, dtype=float)
+        if C.ndim != 1 or C.size == 0:
+            raise ValueError(f"capacity must be an (n,) array, got shape {C.shape}")
+        n = C.shape[0]
+        _positive("heat capacity", C, n, " (J/K)")
+        if graph is not None and graph.n_nodes != n:
+            raise ValueError(f"the graph has {graph.n_nodes} nodes, capacity {n}")
+        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        if edges.size and (edges.min() < 0 or edges.max() >= n):
+            raise ValueError(f"edge node index out of range 0..{n - 1}")
+        G = np.asarray(conductance, dtype=float)
+        if G.shape != (edges.shape[0],):
+            raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {G.shape}")
+        if not np.all(np.isfinite(G)) or np.any(G < 0):
+            raise MaterialError("thermal conductances must be finite and >= 0 (W/K); check the conductivity")
+        self.theta = theta_of(theta)
+        if not (0.0 < safety <= 1.0):
+            raise ValueError(f"safety must be in (0, 1], got {safety}")
+        self.subcycle, self.safety, self.max_substeps = bool(subcycle), float(safety), int(max_substeps)
+        self.n, self.capacity, self.edges, self.conductance = n, _ro(C), edges, _ro(G)
+        self.graph = graph
+        default_area = area if area is not None else (exposed_area(graph) if graph is not None else None)
+        if default_area is not None:
+            default_area = np.asarray(default_area, dtype=float)
+            if default_area.shape != (n,):
+                raise ValueError(f"area must be an ({n},) array, got {default_area.shape}")
+
+        # boundary conditions -> per-node arrays
+        self.fixed_bcs, self.flux_bcs, self.convection_bcs = list(fixed), list(flux), list(convection)
+        names = [b.name for b in self.fixed_bcs + self.flux_bcs + self.convection_bcs]
+        if len(set(names)) != len(names):
+            raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
+        owner = np.full(n, -1, dtype=np.int64)
+        self._fixed_nodes = {}
+        for k, b in enumerate(self.fixed_bcs):
+            nodes = _resolve_nodes(b, n, graph)
+            clash = nodes[owner[nodes] >= 0]
+            if clash.size:
+                raise BoundaryConditionError(
+                    f"{clash.size} element(s) are in both fixed-temperature sets "
+                    f"{self.fixed_bcs[owner[clash[0]]].name!r} and {b.name!r}; make them disjoint")
+            owner[nodes] = k
+            self._fixed_nodes[b.name] = nodes
+        self._fixed_value = {b.name: float(b.temperature) for b in self.fixed_bcs}
+        self.fixed = owner >= 0
+        self.fixed.setflags(write=False)
+        q = np.zeros(n)
+        for b in self.flux_bcs:
+            nodes = _resolve_nodes(b, n, graph)
+            if b.power is not None:
+                if b.area is None:
+                    share = np.full(nodes.size, 1.0 / nodes.size)
+                else:
+                    a = _resolve_area(b, nodes, n, None)
+                    if a.sum() <= 0:
+                        raise BoundaryConditionError(f"heat flux {b.name!r}: the areas sum to 0")
+                    share = a / a.sum()
+                np.add.at(q, nodes, b.power * share)
+            else:
+                np.add.at(q, nodes, b.flux * _resolve_area(b, nodes, n, default_area))
+        hA, hAT = np.zeros(n), np.zeros(n)
+        for b in self.convection_bcs:
+            nodes = _resolve_nodes(b, n, graph)
+            ha = b.h * _resolve_area(b, nodes, n, default_area)
+            np.add.at(hA, nodes, ha)
+            np.add.at(hAT, nodes, ha * b.t_inf)
+        hA[self.fixed] = 0.0
+        hAT[self.fixed] = 0.0
+        q[self.fixed] = 0.0
+        self.flux_power, self.h_area, self._hAT = _ro(q), _ro(hA), hAT
+
+        # matrices, split free (u) / fixed (d)
+        self.K = laplacian(edges, G, n).tocsr()
+        M = (self.K + sp.diags(hA)).tocsr()
+        self._u = np.flatnonzero(~self.fixed)
+        self._d = np.flatnonzero(self.fixed)
+        Mu = M[self._u]
+        self._Muu = Mu[:, self._u].tocsr()
+        self._Mud = Mu[:, self._d].tocsr()
+        self._Kd = self.K[self._d].tocsr()       # heat leaving the fixed nodes
+        self._Cu = C[self._u]
+        self.critical_time_step = stable_time_step(C, edges, G, hA, self.fixed)
+        self._solver = make_solver(solver)
+        self._A = None
+        self._A_key = None
+
+        T = np.broadcast_to(np.asarray(temperature, dtype=float), (n,)).copy()
+        self._apply_fixed(T)
+        if not np.all(np.isfinite(T)):
+            raise ThermalError(f"initial temperatures must be finite; non-finite at nodes "
+                               f"{np.flatnonzero(~np.isfinite(T))[:10].tolist()}")
+        self._T = T
+        self.time = float(time)
+        self.steps = 0
+        self.substeps = 0
+        self.energy = dict(source=0.0, absorbed=0.0, flux=0.0, convection=0.0, boundary=0.0)
+
+    # -- construction from a graph ----------------------------------------------------------
+    @classmethod
+    def from_graph(cls, graph: ContactGraph, density, specific_heat, conductivity, temperature, *,
+                   law: str = "continuum", law_params: Optional[dict] = None, volume_fraction=None,
+                   cell_volume=None, **kw) -> "HeatSolver":
+        """A solver on ``graph``: capacities by :func:`heat_capacity`, conductances by
+        :func:`thermal_conductance` with ``law``; other keywords go to the constructor."""
+        C = heat_capacity(graph, density, specific_heat, volume_fraction=volume_fraction, cell_volume=cell_volume)
+        G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
+        return cls(C, graph.edges, G, temperature, graph=graph, **kw)
+
+    # -- state -----------------------------------------------------------------------------------
+    def _apply_fixed(self, T):
+        for name, nodes in self._fixed_nodes.items():
+            T[nodes] = self._fixed_value[name]
+
+    @property
+    def temperature(self) -> np.ndarray:
+        """Current temperatures (read-only copy)."""
+        return _ro(self._T)
+
+    @property
+    def state(self) -> ThermalState:
+        return ThermalState(self.temperature, self.time)
+
+    def set_temperature(self, temperature):
+        """Replace the temperatures (fixed nodes keep their imposed value); non-finite raise
+        ThermalError and change nothing."""
+        T = np.broadcast_to(np.asarray(temperature, dtype=float), (self.n,)).copy()
+        if not np.all(np.isfinite(T)):
+            raise ThermalError(f"non-finite temperatures at nodes {np.flatnonzero(~np.isfinite(T))[:10].tolist()}; "
+                               "the state is unchanged")
+        self._apply_fixed(T)
+        self._T = T
+
+    def set_fixed_temperature(self, name: str, temperature: float):
+        """Change the value of a fixed-temperature set (from the next step on)."""
+        if name not in self._fixed_value:
+            raise BoundaryConditionError(f"no fixed-temperature set named {name!r}; have {sorted(self._fixed_value)}")
+        self._fixed_value[name] = _finite(f"fixed temperature {name!r}", temperature)
+        self._T[self._fixed_nodes[name]] = self._fixed_value[name]
+
+    def heat_content(self, reference) -> float:
+        """``sum_i C_i (T_i - reference)`` [J]."""
+        return float(np.sum(self.capacity * (self._T - reference)))
+
+    def allowed_time_step(self) -> float:
+        """Largest (sub-)step the integrator takes in one go [s] (inf for theta >= 1/2)."""
+        if self.theta >= 0.5:
+            return math.inf
+        return self.safety * self.critical_time_step / (1.0 - 2.0 * self.theta)
+
+    # -- stepping --------------------------------------------------------------------------------
+    def _matrix(self, h):
+        key = (h, self.theta)
+        if self._A_key != key:
+            self._A = (sp.diags(self._Cu / h) + self.theta * self._Muu).tocsc()
+            self._A_key = key
+        return self._A
+
+    def _check_dt(self, dt):
+        try:
+            dt = float(dt)
+        except (TypeError, ValueError):
+            raise ValueError(f"dt must be a number, got {dt!r}") from None
+        if not (np.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be finite and > 0 (s), got {dt}")
+        return dt
+
+    def substeps_for(self, dt: float) -> int:
+        """Number of sub-steps a step ``dt`` takes (raises ThermalError if sub-cycling is off
+        and dt is above the allowed step)."""
+        dt = self._check_dt(dt)
+        allowed = self.allowed_time_step()
+        if dt <= allowed:
+            return 1
+        if not self.subcycle:
+            raise ThermalError(
+                f"time step {dt:.6g} s is above the stable step of the theta={self.theta:g} scheme "
+                f"({allowed:.6g} s = safety {self.safety:g} x dt_crit {self.critical_time_step:.6g} s"
+                f"{'' if self.theta == 0 else f' / (1 - 2 theta)'}); reduce dt, allow sub-cycling "
+                "(subcycle=True) or use theta='backward-euler'")
+        n_sub = int(math.ceil(dt / allowed))
+        if n_sub > self.max_substeps:
+            raise ThermalError(f"time step {dt:.6g} s needs {n_sub} explicit sub-steps of at most {allowed:.3g} s "
+                               f"(max_substeps={self.max_substeps}); use theta='backward-euler' or a smaller dt")
+        return n_sub
+
+    def trial(self, dt: float, sources=None):
+        """Temperatures after a step ``dt`` with ``sources`` [W per node], without changing the
+        state. Returns ``(T_new, HeatStep)``."""
+        dt = self._check_dt(dt)
+        n = self.n
+        if sources is None:
+            src = np.zeros(n)
+        else:
+            src = np.asarray(sources, dtype=float)
+            if src.shape != (n,):
+                raise ValueError(f"sources must be an ({n},) array (W per node), got shape {src.shape}")
+            if not np.all(np.isfinite(src)):
+                raise ThermalError(f"non-finite heat sources at nodes {np.flatnonzero(~np.isfinite(src))[:10].tolist()}; "
+                                   "the state is unchanged (check the electrical solution)")
+        n_sub = self.substeps_for(dt)
+        h = dt / n_sub
+        u, d, th = self._u, self._d, self.theta
+        T = self._T.copy()
+        Td = T[d]
+        MudTd = self._Mud @ Td
+        s_u = src[u] + self.flux_power[u] + self._hAT[u]
+        Tu = T[u]
+        Tu_theta_sum = np.zeros(u.size)
+        info = {"theta": th, "iterations": 0}
+        with np.errstate(over="ignore", invalid="ignore"):
+            for _ in range(n_sub):
+                if th == 0.0:
+                    Tu_new = Tu + h / self._Cu * (s_u - self._Muu @ Tu - MudTd)
+                else:
+                    rhs = self._Cu / h * Tu - (1.0 - th) * (self._Muu @ Tu) - MudTd + s_u
+                    A = self._matrix(h)
+                    if not np.all(np.isfinite(rhs)):
+                        Tu = rhs
+                        break
+                    try:
+                        Tu_new, sinfo = self._solver.solve(A, rhs, x0=Tu)
+                    except (RuntimeError, ArithmeticError) as exc:
+                        raise ThermalError(
+                            f"the linear solve of the theta={th:g} step failed ({exc}); the state is unchanged. "
+                            f"With dt = {h:.3g} s, C/dt is {np.min(self._Cu / h):.3g} W/K at the least: on a "
+                            "network with no fixed temperature and no convection a step this long leaves the "
+                            "matrix numerically singular; take a shorter step") from exc
+                    info.update(sinfo)
+                Tu_theta_sum += th * Tu_new + (1.0 - th) * Tu
+                Tu = Tu_new
+                if not np.all(np.isfinite(Tu)):
+                    break
+        if not np.all(np.isfinite(Tu)):
+            bad = u[~np.isfinite(Tu)]
+            raise ThermalError(
+                f"non-finite temperatures at nodes {bad[:10].tolist()} after a step of {dt:.6g} s at t = "
+                f"{self.time:.6g} s (theta={th:g}, {n_sub} sub-step(s)); the state is unchanged: check the "
+                "sources and material data, or reduce dt")
+        T[u] = Tu
+        # energies (exact discrete balance of the theta scheme)
+        Tth = self._T.copy()
+        Tth[u] = Tu_theta_sum / n_sub
+        boundary = dt * float(np.sum(self._Kd @ Tth)) if d.size else 0.0
+        convection = dt * float(np.sum(self._hAT[u] - self.h_area[u] * Tth[u]))
+        step = HeatStep(time=self.time + dt, dt=dt, n_substeps=n_sub,
+                        source_energy=dt * float(np.sum(src[u])), absorbed_energy=dt * float(np.sum(src[d])),
+                        flux_energy=dt * float(np.sum(self.flux_power[u])), convection_energy=convection,
+                        boundary_energy=boundary,
+                        heat_change=float(np.sum(self._Cu * (Tu - self._T[u]))), info=info)
+        return T, step
+
+    def advance(self, dt: float, sources=None) -> HeatStep:
+        """Advance the temperatures by ``dt`` [s] with nodal ``sources`` [W] held constant.
+
+        Raises
+        ------
+        ValueError
+            dt not finite and > 0, sources of the wrong shape.
+        ThermalError
+            Non-finite sources or temperatures (the state is left as it was), or a step above
+            the stable one with sub-cycling off.
+        """
+        T, step = self.trial(dt, sources)
+        self._T = T
+        self.time = step.time
+        self.steps += 1
+        self.substeps += step.n_substeps
+        e = self.energy
+        e["source"] += step.source_energy
+        e["absorbed"] += step.absorbed_energy
+        e["flux"] += step.flux_energy
+        e["convection"] += step.convection_energy
+        e["boundary"] += step.boundary_energy
+        return step
