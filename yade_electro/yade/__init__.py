@@ -6,7 +6,7 @@ Importing this subpackage does not import YADE by itself; the functions that nee
 
 from .runtime import import_yade, in_yade  # noqa: E402
 from .scene import SceneReader, write_body_attribute, predicate_selector  # noqa: E402
-from .engines import ElectricalEngine, get_engine, ENGINES  # noqa: E402
+from .engines import ElectricalEngine, ElectroThermalEngine, ensure_thermal_state, get_engine, ENGINES  # noqa: E402
 
 __all__ = ["import_yade", "in_yade", "SceneReader", "write_body_attribute", "predicate_selector",
-           "ElectricalEngine", "get_engine", "ENGINES"]
+           "ElectricalEngine", "ElectroThermalEngine", "ensure_thermal_state", "get_engine", "ENGINES"]

@@ -21,6 +21,7 @@ bodies with ``b.mask & m``.
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 from typing import Dict, Optional
 
@@ -30,7 +31,7 @@ from ..engine import ElectricalModel, ElectrodeSpec, History
 from .runtime import import_yade
 from .scene import SceneReader, predicate_selector, write_body_attribute
 
-__all__ = ["ElectricalEngine", "ENGINES", "get_engine"]
+__all__ = ["ElectricalEngine", "ElectroThermalEngine", "ensure_thermal_state", "ENGINES", "get_engine"]
 
 log = logging.getLogger(__name__)
 
@@ -177,3 +178,106 @@ class ElectricalEngine:
         """Take the engine out of ``O.engines`` and the registry."""
         self.O.engines = [e for e in self.O.engines if e is not self.runner]
         ENGINES.pop(self.label, None)
+
+
+def ensure_thermal_state(bodies) -> int:
+    """Give every body a ``ThermalState`` (YADE's state with ``temp``), carrying over all the
+    attributes of its current state (position, velocity, mass, blocked DOFs...). Returns how
+    many states were replaced."""
+    yade = import_yade()
+    replaced = 0
+    for b in bodies:
+        if not isinstance(b.state, yade.ThermalState):
+            ts = yade.ThermalState()
+            ts.updateAttrs(b.state.dict())
+            b.state = ts
+            replaced += 1
+    return replaced
+
+
+class ElectroThermalEngine(ElectricalEngine):
+    """Joule heating and heat conduction every ``iterPeriod`` steps of a YADE simulation.
+
+    Each call reads the graph (only what changed), solves the potential (again only when the
+    graph, rho_e(T) or an electrode value changed), computes the Joule heat, advances the
+    temperatures by the thermal time step and writes them to ``b.state.temp`` (a
+    ``ThermalState`` is given to bodies that do not have one), and the potential to
+    ``b.potential``. One history row per call is written to the CSV as the run goes.
+
+    Thermal time: by default each call advances by the simulated time elapsed since the
+    previous call (``O.time`` difference) times ``time_scale``; give ``thermal_dt`` to
+    advance by a fixed thermal step per call instead (the heat and mechanics then run on
+    separate clocks). Either way the integrator sub-cycles (explicit) or takes the step in
+    one implicit solve (theta method), so it is never bound to ``O.dt``.
+
+    Parameters
+    ----------
+    resistivity, electrodes, law, law_params, solver, measure, iterPeriod, history, bonds,
+    mask, geometry_every, move_tolerance, full_read_every, plot, label : see ElectricalEngine
+    density [kg/m^3], specific_heat [J/(kg K)], conductivity [W/(m K)] : thermal material
+    temperature : initial temperature [K]
+    beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
+    theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
+    fixed, flux, convection : lists of ``yade_electro.thermal`` FixedTemperature, HeatFlux,
+        Convection; their ``nodes`` may be YADE predicates, body id lists or masks
+    thermal_dt : float, optional; time_scale : float
+    coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
+    """
+
+    def __init__(self, resistivity, electrodes, density, specific_heat, conductivity, temperature,
+                 beta=0.0, eta=1.0, theta="backward-euler", fixed=(), flux=(), convection=(),
+                 thermal_dt=None, time_scale=1.0, coupled_options=None, label="electrothermal", **kw):
+        from ..coupled import ElectroThermalModel
+        self._thermal_setup = None
+        super().__init__(resistivity, electrodes, label=label, **kw)
+        bcs = []
+        for group in (fixed, flux, convection):
+            out = []
+            for bc in group:
+                out.append(dataclasses.replace(bc, nodes=_normalise_selector(bc.nodes, self.reader)))
+            bcs.append(out)
+        if thermal_dt is not None and not (thermal_dt > 0):
+            raise ValueError(f"thermal_dt must be > 0 (s), got {thermal_dt}")
+        if not (time_scale > 0):
+            raise ValueError(f"time_scale must be > 0, got {time_scale}")
+        self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
+        self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature,
+                                           beta=beta, eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1],
+                                           convection=bcs[2], **(coupled_options or {}))
+        self._last_time = float(self.O.time)
+
+    def step(self):
+        """One coupled step on the current scene (what the PyRunner calls)."""
+        graph = self.reader.read()
+        if self.thermal_dt is not None:
+            dt = self.thermal_dt
+        else:
+            dt = (float(self.O.time) - self._last_time) * self.time_scale
+        if dt <= 0:             # first call at the start of a run: nothing to integrate yet
+            dt = None
+        if dt is None:
+            self.coupled._prepare(graph)
+            self.coupled._solve_potential(graph)
+            row = self.coupled.summary()
+        else:
+            row = self.coupled.step(graph, dt, self.values or None)
+        self._last_time = float(self.O.time)
+        bodies = self.reader.bodies
+        ensure_thermal_state(bodies)
+        for b, t in zip(bodies, self.coupled.temperature.tolist()):
+            b.state.temp = t
+        if self.write_back:
+            write_body_attribute(bodies, self.write_back, self.model.solution.potential)
+        out = {"iter": int(self.O.iter), "mech_time": float(self.O.time)}
+        out.update(row)
+        out["graph_revision"] = int(graph.revision)
+        self.history.append(out)
+        if self.plot:
+            from yade import plot
+            plot.addData(**{f"electro_{k}": v for k, v in out.items()})
+        return out
+
+    @property
+    def temperature(self) -> np.ndarray:
+        """Temperature [K] of each element, in ``body_ids`` order."""
+        return self.coupled.temperature
