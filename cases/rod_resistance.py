@@ -79,6 +79,8 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     container = pack.inCylinder((0, 0, 0), (0, 0, LENGTH), RADIUS)
     packing = P.dense_packing(container, n=n, seed=seed, cache_dir=cache_dir)
     t_pack = time.perf_counter() - t0
+    if law == "voronoi":
+        law_params = {"container": P.as_shape(container), **(law_params or {})}
     kw = {} if detection_factor is None else {"detection_factor": detection_factor}
     ids = P.add_bonded_packing(packing, **kw)
     r_mean = float(np.mean(packing.radii))

@@ -95,6 +95,11 @@ class ElectricalEngine:
         self.O = O if O is not None else yade.Omega()
         self.reader = SceneReader(self.O, bonds=bonds, mask=mask, geometry_every=geometry_every,
                                   move_tolerance=move_tolerance, full_read_every=full_read_every)
+        law_params = dict(law_params or {})
+        if _is_predicate(law_params.get("container")):
+            # the voronoi law needs a signed distance: convert YADE's predicate
+            from .packing import as_shape
+            law_params["container"] = as_shape(law_params["container"])
         specs = []
         for name, spec in dict(electrodes).items():
             spec = dict(spec)
