@@ -24,6 +24,7 @@ DEB_PACKAGES=(
   yade liggghts
   python3-pip python3-setuptools python3-wheel
   python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest python3-meshio
+  gmsh python3-gmsh
 )
 
 # PyPI packages Debian 12 lacks, pinned to the newest release that declares support for
