@@ -64,7 +64,7 @@ def end_layers(z, r, r_mean, gap=0.1, length=LENGTH):
 
 
 def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_params=None, solver="cg",
-            gap=0.1, detection_factor=None, cache_dir=None, history=None):
+            gap=0.1, detection_factor=None, cache_dir=None, history=None, elements_csv=None):
     """Build (or load from the cache) the bonded rod in YADE, solve it with the electrical
     engine, and return a dict of figures (n, r_mean, R_dem, R_th, error_pct, packing stats,
     timings). Resets YADE's scene first."""
@@ -95,13 +95,18 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     t1 = time.perf_counter()
     O.step()
     t_solve = time.perf_counter() - t1
-    g = engine.graph
+    g = engine.bond_graph           # the bonds (the 'voronoi' law conducts on a wider network)
     from yade_electro.surfaces import eccentricity
     e = eccentricity(g)
     R_dem = engine.equivalent_resistance
     R_th = theoretical_resistance(r_mean, rho)
     sol = engine.solution
     engine.remove()
+    if elements_csv is not None:        # per-element results
+        np.savetxt(elements_csv,
+                   np.column_stack([g.ids, g.pos, g.radius, g.degree, e, sol.potential]),
+                   delimiter=",", header="body_id,x,y,z,radius,neighbours,eccentricity,potential",
+                   comments="", fmt=["%d", "%.9e", "%.9e", "%.9e", "%.9e", "%d", "%.6f", "%.9e"])
     return {
         "case": "rod_resistance", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed), "law": law,
         "r_mean": r_mean, "R_dem": float(R_dem), "R_th": float(R_th),
@@ -193,7 +198,7 @@ def _params(argv):
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/rod_resistance")
     args = ap.parse_args(argv)
-    if os.environ.get("PARAM_TABLE"):
+    if os.environ.get("YADE_BATCH"):    # run by yade-batch: the table line gives the parameters
         from yade import utils
         utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.law, noTableOk=True)
         from yade.params import table
@@ -213,13 +218,38 @@ def main(argv=None):
         print(json.dumps(summary))
         return summary
     os.makedirs(args.out, exist_ok=True)
+    stem = os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}")
     row = run_rod(args.n, args.seed, law=args.law, solver=args.solver, gap=args.gap,
-                  history=os.path.join(args.out, f"history_n{args.n}_s{args.seed}.csv"))
-    with open(os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}.json"), "w") as fh:
+                  history=stem + "_history.csv", elements_csv=stem + "_elements.csv")
+    with open(stem + ".json", "w") as fh:
         json.dump(row, fh)
-    plot_sweep([row], os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}.png"))
+    plot_profile(stem + "_elements.csv", row, stem + ".png")
+    print(f"rod R = {RADIUS * 1e3:g} mm, L = {LENGTH * 1e3:g} mm, {row['n']} elements (r_mean "
+          f"{row['r_mean'] * 1e6:.1f} um), law {args.law}: R_dem = {row['R_dem'] * 1e3:.5f} mohm, "
+          f"R_th = {row['R_th'] * 1e3:.5f} mohm, error {row['error_pct']:+.2f} %")
+    print(f"wrote {stem}_history.csv, {stem}_elements.csv, {stem}.png")
     print(json.dumps(row))
     return row
+
+
+def plot_profile(elements_csv, row, path):
+    """Element potentials along the rod axis against the linear theory between the electrode
+    planes (z = r_mean and z = L - r_mean)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    d = np.genfromtxt(elements_csv, delimiter=",", names=True)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(d["z"] * 1e3, d["potential"], ".", ms=2, alpha=0.4, label="elements")
+    rm = row["r_mean"]
+    ax.plot([rm * 1e3, (LENGTH - rm) * 1e3], [0, 1], "k-", lw=1, label="uniform field (theory)")
+    ax.set_xlabel("z [mm]")
+    ax.set_ylabel("potential [V]")
+    ax.set_title(f"rod, {row['n']} elements, {row['law']}: R error {row['error_pct']:+.2f} %")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -146,7 +146,13 @@ class ElectricalEngine:
     # -- results -------------------------------------------------------------------------
     @property
     def graph(self):
+        """The network the current flows in (the bond graph, or wider for the 'voronoi' law)."""
         return self.model.graph
+
+    @property
+    def bond_graph(self):
+        """The bonded contact graph read from the scene."""
+        return self.model.bond_graph
 
     @property
     def solution(self):
