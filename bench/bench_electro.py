@@ -17,7 +17,9 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+# yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
+_SCRIPT = __file__ if __file__.endswith("bench_electro.py") else (sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_electro.py") else __file__)
+HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 sys.path.insert(0, os.path.dirname(HERE))
 
 from yade_electro.yade.runtime import import_yade  # noqa: E402
@@ -57,6 +59,9 @@ def bench_size(n, repeat=5, seed=1):
     out["extract_full_ms"], (reader, graph) = best(full_read, repeat)
     out["n_edges"] = int(graph.n_edges)
     out["extract_unchanged_ms"], _ = best(reader.read, repeat)
+    reader_count = SceneReader(O, geometry_every=0, bond_check="count")
+    reader_count.read()
+    out["extract_unchanged_count_only_ms"], _ = best(reader_count.read, repeat)
     reader_geo = SceneReader(O, geometry_every=1)
     reader_geo.read()
     out["extract_unchanged_with_positions_ms"], _ = best(reader_geo.read, repeat)
@@ -85,6 +90,21 @@ def bench_size(n, repeat=5, seed=1):
         out[f"{name}_iterations_cold"] = int(sol.info.get("iterations", 0))
         out[f"{name}_R_eq"] = sol.equivalent_resistance("top", "bottom")
         out[f"{name}_residual"] = sol.residual
+
+    # the 'voronoi' law: tessellation (once), then a rebuild after a bond broke
+    from yade_electro.engine import ElectricalModel
+    el = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
+          "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
+    model = ElectricalModel(rod.RHO_304L, el, law="voronoi",
+                            law_params=dict(container=P.as_shape(pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS))))
+    t = time.perf_counter()
+    model.solve(graph)
+    out["voronoi_first_solve_ms"] = time.perf_counter() - t
+    broken = graph.with_edges(graph.edges[1:])
+    t = time.perf_counter()
+    model.solve(broken)
+    out["voronoi_after_bond_break_ms"] = time.perf_counter() - t
+    out["voronoi_R_eq"] = model.equivalent_resistance
 
     O.dt = 0.5 * yade.utils.PWaveTimeStep()
     O.step()

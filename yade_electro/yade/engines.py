@@ -76,7 +76,7 @@ class ElectricalEngine:
         Steps between two solves (the PyRunner's period).
     history : str, optional
         CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
-    bonds, mask, geometry_every, move_tolerance, full_read_every : see ``SceneReader``
+    bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check : see ``SceneReader``
     write_back : str or None
         Body attribute that receives each element's potential [V] (default 'potential');
         None to skip.
@@ -89,12 +89,13 @@ class ElectricalEngine:
     def __init__(self, resistivity, electrodes, law="continuum", law_params=None, solver="cg",
                  measure=None, iterPeriod: int = 1, history: Optional[str] = None, bonds="cohesive",
                  mask=None, geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0,
-                 write_back: Optional[str] = "potential", plot: bool = False, label: str = "electro",
+                 bond_check: str = "flags", write_back: Optional[str] = "potential", plot: bool = False, label: str = "electro",
                  O=None):
         yade = import_yade()
         self.O = O if O is not None else yade.Omega()
         self.reader = SceneReader(self.O, bonds=bonds, mask=mask, geometry_every=geometry_every,
-                                  move_tolerance=move_tolerance, full_read_every=full_read_every)
+                                  move_tolerance=move_tolerance, full_read_every=full_read_every,
+                                  bond_check=bond_check)
         law_params = dict(law_params or {})
         if _is_predicate(law_params.get("container")):
             # the voronoi law needs a signed distance: convert YADE's predicate

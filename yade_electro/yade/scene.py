@@ -69,10 +69,20 @@ class SceneReader:
         check cannot see an interaction that *becomes* a bond while the number of real
         interactions stays the same (re-bonding by ``setCohesionNow`` during a run); set
         this when a simulation does that.
+    bond_check : {'flags', 'count'}
+        'flags' (default): every call reads the bond flag of each kept edge (~0.4 us each:
+        6 ms for 17,000 bonds), so a bond that breaks while its spheres stay in contact is
+        seen at once. 'count': only the numbers of bodies and real interactions are
+        compared (under 1 ms); a bond broken in shear or compression, whose contact
+        survives, is then seen only at the next full read (``full_read_every``).
     """
 
     def __init__(self, O=None, bonds: str = "cohesive", mask: Optional[int] = None,
-                 geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0):
+                 geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0,
+                 bond_check: str = "flags"):
+        if bond_check not in ("flags", "count"):
+            raise ValueError(f"bond_check must be 'flags' or 'count', got {bond_check!r}")
+        self.bond_check = bond_check
         if bonds not in ("cohesive", "contacts"):
             raise ValueError(f"bonds must be 'cohesive' or 'contacts', got {bonds!r}")
         if O is None:
@@ -116,6 +126,8 @@ class SceneReader:
     def _changed(self) -> bool:
         if self._stamp_now() != self._stamp:
             return True
+        if self.bond_check == "count":
+            return False
         for inter, flag in zip(self._kept, self._flags):
             if not inter.isReal or (flag is not None and not flag(inter.phys)):
                 return True
