@@ -34,7 +34,9 @@ import time
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
+# yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
+_SCRIPT = __file__ if __file__.endswith("rod_resistance.py") else (sys.argv[0] if sys.argv and sys.argv[0].endswith("rod_resistance.py") else __file__)
+HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, os.path.dirname(HERE))
 
@@ -81,7 +83,10 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     t_pack = time.perf_counter() - t0
     if law == "voronoi":
         law_params = {"container": P.as_shape(container), **(law_params or {})}
-    kw = {} if detection_factor is None else {"detection_factor": detection_factor}
+    if detection_factor is None:
+        import inspect
+        detection_factor = inspect.signature(P.add_bonded_packing).parameters["detection_factor"].default
+    kw = {"detection_factor": detection_factor}
     ids = P.add_bonded_packing(packing, **kw)
     r_mean = float(np.mean(packing.radii))
     z, r = packing.centers[:, 2], packing.radii
@@ -109,6 +114,7 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
                    comments="", fmt=["%d", "%.9e", "%.9e", "%.9e", "%.9e", "%d", "%.6f", "%.9e"])
     return {
         "case": "rod_resistance", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed), "law": law,
+        "detection_factor": detection_factor,
         "r_mean": r_mean, "R_dem": float(R_dem), "R_th": float(R_th),
         "error_pct": float(100.0 * (R_dem - R_th) / R_th),
         "volume_fraction": float(np.sum(4.0 / 3.0 * np.pi * r ** 3) / (math.pi * RADIUS ** 2 * LENGTH)),
@@ -193,7 +199,9 @@ def _params(argv):
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--law", default="continuum")
     ap.add_argument("--solver", default="cg")
-    ap.add_argument("--gap", type=float, default=0.1)
+    ap.add_argument("--gap", type=float, default=0.1, help="electrode layer: z - r <= gap r_mean")
+    ap.add_argument("--k", type=float, default=None,
+                    help="bond detection factor (default that of add_bonded_packing, 1.04)")
     ap.add_argument("--sweep", action="store_true", help="all sizes x 3 seeds (Table III)")
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/rod_resistance")
@@ -209,7 +217,8 @@ def _params(argv):
 def main(argv=None):
     args = _params(sys.argv[1:] if argv is None else argv)
     if args.sweep:
-        rows = sweep(args.sizes, SEEDS, args.out, law=args.law, solver=args.solver, gap=args.gap)
+        rows = sweep(args.sizes, SEEDS, args.out, law=args.law, solver=args.solver, gap=args.gap,
+                     detection_factor=args.k)
         print(table_markdown(rows))
         summary = {"case": "rod_resistance", "law": args.law, "rows": [
             {k: r[k] for k in ("n", "n_target", "seed", "r_mean", "R_dem", "R_th", "error_pct")} for r in rows]}
@@ -219,7 +228,7 @@ def main(argv=None):
         return summary
     os.makedirs(args.out, exist_ok=True)
     stem = os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}")
-    row = run_rod(args.n, args.seed, law=args.law, solver=args.solver, gap=args.gap,
+    row = run_rod(args.n, args.seed, law=args.law, solver=args.solver, gap=args.gap, detection_factor=args.k,
                   history=stem + "_history.csv", elements_csv=stem + "_elements.csv")
     with open(stem + ".json", "w") as fh:
         json.dump(row, fh)
