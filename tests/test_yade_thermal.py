@@ -1,0 +1,90 @@
+"""ElectroThermalEngine in the real YADE (each case a fresh ``yade -n -x`` process)."""
+import csv
+import io
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+SCENE = r'''
+import json, math
+import numpy as np
+from yade import pack, utils
+from yade_electro.yade import ElectroThermalEngine
+from yade_electro.thermal import Convection
+O.materials.append(CohFrictMat(young=210e9, poisson=0.3, density=7900, normalCohesion=1e8, shearCohesion=1e8,
+                               momentRotationLaw=True, label="steel"))
+r = 1e-4
+O.bodies.append(pack.regularHexa(pack.inAlignedBox((0, 0, 0), (1e-3, 1e-3, 3e-3)), radius=r, gap=0, material="steel"))
+O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(aabbEnlargeFactor=1.1, label="bo")]),
+             InteractionLoop([Ig2_Sphere_Sphere_ScGeom6D(interactionDetectionFactor=1.1, label="ig")],
+                             [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys(setCohesionNow=True, setCohesionOnNewContacts=False)],
+                             [Law2_ScGeom6D_CohFrictPhys_CohesionMoment()]),
+             NewtonIntegrator(damping=0.4)]
+O.dt = 1e-9
+O.step()
+bo.aabbEnlargeFactor = -1
+ig.interactionDetectionFactor = -1
+zs = [b.state.pos[2] for b in O.bodies]
+TOP = pack.inAlignedBox((-1, -1, max(zs) - 0.5 * r), (1, 1, 1))
+BOTTOM = pack.inAlignedBox((-1, -1, -1), (1, 1, min(zs) + 0.5 * r))
+'''
+
+HEATING = SCENE + r'''
+e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=VOLTAGE), "bottom": dict(select=BOTTOM, potential=0.0)},
+                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
+                         thermal_dt=1e-3, iterPeriod=1, history="heat.csv", theta=THETA)
+O.engines = O.engines + [e.runner]
+out = {}
+try:
+    O.run(STEPS_BEFORE, True)
+    if BLOWUP:
+        e.set_electrode("top", 1e160)   # the Joule power overflows from the next call on
+    O.run(5 - STEPS_BEFORE, True)
+except Exception as exc:
+    out["error"] = str(exc)
+rows = e.history.rows
+out.update(n_rows=len(rows), iters=[r["iter"] for r in rows])
+if rows:
+    last = rows[-1]
+    out.update(time=last["time"], joule_energy=last["joule_energy"], heat=last["heat_content"], T_mean=last["T_mean"],
+               power=last["joule_power"], T_max=last["T_max"])
+    temps = [b.state.temp for b in O.bodies]
+    out.update(state_type=type(O.bodies[0].state).__name__, body_T_min=min(temps), body_T_max=max(temps),
+               model_T_max=float(max(e.temperature)), potential_written=hasattr(O.bodies[0], "potential"))
+print(json.dumps(out))
+'''
+
+
+def _run(run_yade_script, tmp_path, voltage, theta="backward-euler", blowup=False):
+    src = (HEATING.replace("VOLTAGE", repr(voltage)).replace("THETA", repr(theta))
+           .replace("STEPS_BEFORE", "2").replace("BLOWUP", repr(blowup)))
+    return run_yade_script(src, timeout=120, cwd=tmp_path, check=True).result
+
+
+@pytest.mark.parametrize("theta", ["backward-euler", "explicit"])
+def test_adiabatic_heating_writes_temperatures(run_yade_script, tmp_path, theta):
+    out = _run(run_yade_script, tmp_path, 0.1, theta)
+    assert "error" not in out
+    assert out["n_rows"] == 5 and out["time"] == pytest.approx(5e-3)
+    # adiabatic: the heat gained is the Joule energy (the thermal core checks 1e-9 on its own)
+    assert out["heat"] == pytest.approx(out["joule_energy"], rel=1e-9)
+    assert out["T_mean"] > 293.15
+    assert out["state_type"] == "ThermalState" and out["potential_written"]
+    assert out["body_T_max"] == pytest.approx(out["model_T_max"], rel=1e-12)
+    assert out["body_T_min"] >= 293.15
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "heat.csv").read_text())))
+    assert len(rows) == 5 and float(rows[-1]["joule_energy"]) == pytest.approx(out["joule_energy"])
+
+
+def test_non_finite_temperatures_stop_and_keep_the_history(run_yade_script, tmp_path):
+    # two good steps, then 1e160 V: the Joule power overflows; the run must stop with a clear
+    # error, the bodies keep finite temperatures and the two rows already written stay in the CSV
+    out = _run(run_yade_script, tmp_path, 0.1, blowup=True)
+    assert "non-finite heat sources" in out["error"] and "state is unchanged" in out["error"]
+    assert out["n_rows"] == 2 and out["iters"] == [1, 2]
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "heat.csv").read_text())))
+    assert len(rows) == 2
+    assert all(float(v) == float(v) and abs(float(v)) != float("inf")
+               for r in rows for k, v in r.items() if k not in ("graph_revision",))
+    assert 293.15 <= out["body_T_min"] <= out["body_T_max"] < 1e4
