@@ -293,3 +293,18 @@ def test_model_summary_goes_into_a_history(tmp_path):
     df = h.to_dataframe()
     assert df["V_top"].tolist() == [1.0, 2.0]
     assert df["R_eq"].iloc[0] == pytest.approx(df["R_eq"].iloc[1], rel=1e-12)
+
+
+def test_plot_history_from_csv_and_history(tmp_path):
+    from yade_electro.engine import History
+    from yade_electro.plotting import plot_history
+    h = History(str(tmp_path / "h.csv"))
+    for k in range(4):
+        h.append({"iter": k, "time": 1e-3 * k, "R_eq": 1e-3, "current": 1e3, "joule_power": 1e3,
+                  "joule_energy": 1.0 * k, "heat_content": 1.0 * k, "T_mean": 293.15 + k, "T_max": 294.0 + k,
+                  "T_min": 293.15})
+    for src in (str(tmp_path / "h.csv"), h, h.to_dataframe()):
+        out = plot_history(src, str(tmp_path / "h.png"))
+        assert (tmp_path / "h.png").stat().st_size > 1000 and out.endswith("h.png")
+    with pytest.raises(ValueError, match="no rows"):
+        plot_history(History(), str(tmp_path / "x.png"))
