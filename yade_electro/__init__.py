@@ -14,3 +14,7 @@ from .network import (Electrode, PotentialSolution, laplacian, solve_potential,
                       equivalent_resistance, make_solver, DirectSolver, CGSolver)
 
 __version__ = "0.1.0"
+from .engine import ElectricalModel, ElectrodeSpec, History
+from .thermal import (heat_capacity, thermal_conductance, joule_sources, HeatSolver, FixedTemperature,
+                      HeatFlux, Convection)
+from .coupled import ElectroThermalModel
