@@ -248,3 +248,164 @@ class VoronoiFaces:
         ok = np.asarray(reach[i, j]).ravel() > 0
         out = np.concatenate([self.pairs[ok], np.sort(b, axis=1)])
         return np.unique(out, axis=0)
+
+
+# ---------------------------------------------------------------------------------------
+# cell volumes (heat capacities of the 'voronoi' model)
+# ---------------------------------------------------------------------------------------
+def _cell_halfspaces(pts, i, neighbours):
+    """Half-spaces ``a.x + b <= 0`` (rows [a, b], a unit) of the Voronoi cell of pts[i]."""
+    d = pts[neighbours] - pts[i]
+    nrm = d / np.linalg.norm(d, axis=1)[:, None]
+    mid = 0.5 * (pts[neighbours] + pts[i])
+    return np.column_stack([nrm, -np.einsum("ij,ij->i", nrm, mid)])
+
+
+def _interior_point(hs, guess):
+    """A point strictly inside the half-spaces: ``guess`` if it is, else the Chebyshev centre."""
+    margin = hs[:, :3] @ guess + hs[:, 3]
+    scale = float(np.max(np.abs(hs[:, 3]))) or 1.0
+    if np.max(margin) < -1e-9 * scale:
+        return guess
+    from scipy.optimize import linprog
+    norm = np.linalg.norm(hs[:, :3], axis=1)
+    c = np.zeros(4)
+    c[3] = -1.0
+    res = linprog(c, A_ub=np.column_stack([hs[:, :3], norm]), b_ub=-hs[:, 3],
+                  bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    if not res.success or res.x[3] <= 0:
+        return None
+    return res.x[:3]
+
+
+def _clipped_volume(hs, guess, container, max_planes, rel_tol):
+    """Volume of the convex polytope ``hs`` inside the container, clipped by tangent planes
+    at the nearest surface points of the vertices that stick out, the farthest one first
+    (exact for planar walls; on curved walls the polytope circumscribes the surface:
+    excess O(h^2 / R))."""
+    from scipy.spatial import ConvexHull, HalfspaceIntersection
+    for _ in range(max_planes + 1):
+        x0 = _interior_point(hs, guess)
+        if x0 is None:
+            return 0.0
+        verts = HalfspaceIntersection(hs, x0).intersections
+        d = np.asarray(container.sdf(verts), float)
+        k = int(np.argmax(d))
+        size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
+        if d[k] <= rel_tol * size:
+            break
+        g = np.asarray(container.gradient(verts[k:k + 1]), float)[0]
+        g /= np.linalg.norm(g)
+        foot = verts[k] - d[k] * g
+        hs = np.vstack([hs, np.append(g, -g @ foot)])
+        if container.sdf(guess[None, :])[0] >= -1e-12 * size:   # centre on the wall: move in
+            guess = guess - 1e-3 * size * g
+    return float(ConvexHull(verts).volume)
+
+
+def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: float = 1e-4,
+                         return_info: bool = False):
+    """Volumes [m^3] of the Voronoi cells of the element centres, bounded by the container:
+    the volume of solid each element stands for (heat capacity ``rho c V_cell``).
+
+    The tessellation is the one of :func:`voronoi_faces` (same ghosts across the tangent
+    planes that support the solid, same far points). Cells whose vertices all lie inside
+    the container are measured exactly, as the pyramids from the centre on the faces
+    (sum_j A_ij l_ij / 6). Cells that stick out
+    are intersected (``scipy.spatial.HalfspaceIntersection``) with the tangent planes of the
+    container at the nearest surface points of their outside vertices, one plane at a time
+    (at most ``max_planes``) until no vertex is outside by more than ``rel_tol`` times the
+    cell's size. For planar walls this is exact, so the volumes of a packing in a box sum to
+    the box volume to rounding. On a curved wall the clipped cell is bounded by tangent
+    planes, i.e. it circumscribes the surface: the sum exceeds the container volume by a
+    small relative amount, O((h / R)^2) at most (measured on the rod R = 1 mm, L = 5 mm:
+    +1.0e-4 at 1,000 elements, +3.2e-5 at 5,000; see ``return_info``).
+
+    Parameters
+    ----------
+    pos : (n, 3) element centres [m]
+    radius : (n,) radii [m] (set the width of the band of mirrored elements)
+    container : object with ``sdf`` and ``gradient`` (a shape of ``yade_electro.yade.packing``)
+    max_planes, rel_tol : clipping controls (see above)
+    return_info : bool
+        Also return a dict: ``total`` (sum of the volumes), ``container_volume`` (exact if
+        the container knows it, else None), ``relative_excess`` and ``n_clipped``.
+
+    Returns
+    -------
+    volumes : (n,) [m^3] (and ``info`` with ``return_info``)
+    """
+    pos = np.asarray(pos, float)
+    radius = np.asarray(radius, float)
+    n = pos.shape[0]
+    if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
+        raise ValueError("voronoi_cell_volumes needs container=<the solid's shape>, an object with sdf(x) "
+                         f"and gradient(x); got {container!r}")
+    ghosts, _, _, _ = ghost_points(pos, radius, container)
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
+    mid = 0.5 * (lo + hi)
+    far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    pts = np.concatenate([pos, ghosts, far])
+    vor = Voronoi(pts)
+    out = np.asarray(container.sdf(vor.vertices), float) > rel_tol * 2.0 * float(np.min(radius))
+    rp = vor.ridge_points
+    vol = np.zeros(n)
+    inside = np.zeros(pts.shape[0], bool)
+    for i in range(n):
+        reg = vor.regions[vor.point_region[i]]
+        inside[i] = bool(reg) and -1 not in reg and not out[reg].any()
+    clipped = np.flatnonzero(~inside[:n]).tolist()
+    # cells inside the container: the pyramids from the centre on the faces, of height
+    # l_ij / 2 (a Voronoi face is the perpendicular bisector): V_i = sum_j A_ij l_ij / 6
+    sel = np.flatnonzero(inside[rp[:, 0]] | inside[rp[:, 1]])
+    rv = [vor.ridge_vertices[k] for k in sel]
+    dvec = pts[rp[sel, 1]] - pts[rp[sel, 0]]
+    length = np.linalg.norm(dvec, axis=1)
+    area = _polygon_areas(vor.vertices, rv, dvec / length[:, None])
+    pyramid = area * length / 6.0
+    for side in (0, 1):
+        k = inside[rp[sel, side]]
+        np.add.at(vol, rp[sel[k], side], pyramid[k])
+    if clipped:
+        # neighbours of every clipped cell, from the ridges
+        cl = np.zeros(pts.shape[0], bool)
+        cl[clipped] = True
+        a = np.concatenate([rp[:, 0], rp[:, 1]])
+        b = np.concatenate([rp[:, 1], rp[:, 0]])
+        sel = cl[a]
+        a, b = a[sel], b[sel]
+        order = np.argsort(a, kind="stable")
+        a, b = a[order], b[order]
+        starts = np.searchsorted(a, clipped)
+        ends = np.searchsorted(a, clipped, side="right")
+        for i, s, e in zip(clipped, starts, ends):
+            hs = _cell_halfspaces(pts, i, b[s:e])
+            vol[i] = _clipped_volume(hs, pos[i].copy(), container, max_planes, rel_tol)
+    if not return_info:
+        return vol
+    cv = getattr(container, "exact_volume", None)
+    total = float(vol.sum())
+    return vol, {"total": total, "container_volume": cv,
+                 "relative_excess": (total / cv - 1.0) if cv else None, "n_clipped": len(clipped)}
+
+
+def cell_volume_of(container, **kwargs):
+    """``f(graph) -> (n,)`` bounded Voronoi cell volumes [m^3] of the graph's elements, for
+    ``ElectroThermalModel(cell_volume=...)`` / ``heat_capacity(cell_volume=...)``: the heat
+    capacities that go with the 'voronoi' conductance law (``C_i = rho c V_cell_i``, cells
+    filling the solid instead of paper 000's ``V_i / fv_i``). The volumes are kept while
+    the element set (ids) is the same; other keywords go to :func:`voronoi_cell_volumes`."""
+    cache = {}
+
+    def cell_volume(graph):
+        key = (graph.n_nodes, graph.ids.tobytes())
+        if cache.get("key") != key:
+            cache["key"] = key
+            cache["volumes"] = voronoi_cell_volumes(graph.pos, graph.radius, container, **kwargs)
+        return cache["volumes"]
+    cell_volume.container = container
+    return cell_volume
+
+
+__all__ += ["voronoi_cell_volumes", "cell_volume_of"]

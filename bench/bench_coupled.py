@@ -1,0 +1,147 @@
+"""Cost of one coupled electro-thermal step on the bonded rods of the rod case (5,000 and
+20,000 elements, seed 1, the cached packings), next to one YADE mechanical step.
+
+One coupled step = potential (solve or re-use) + Joule sources + heat advance, by
+``ElectroThermalModel.step(graph, dt)`` on a graph read once from YADE, dt = 1 ms (the
+Joule-rod case's thermal step), 304L, 1 V between the end layers, law 'continuum':
+
+* ``be_unchanged`` / ``explicit_unchanged``: constant resistivity and an unchanged graph,
+  so the potential of the first step is re-used; backward Euler (the factorisation is kept)
+  or explicit sub-cycled to the stable step (the number of sub-steps is printed);
+* ``be_rho_T`` / ``explicit_rho_T``: rho_e(T) with beta = 1e-3 /K, so conductances,
+  Kirchhoff system and potential are re-solved every step (warm-started CG);
+* ``*_first``: the first step (assembly, potential solve, capacities, factorisation);
+* ``engine_call``: the whole PyRunner call of an ``ElectroThermalEngine`` (scene read with
+  the unchanged-graph check, coupled step, temperatures written to ``b.state.temp`` and
+  potentials to ``b.potential``, history row), backward Euler, constant resistivity;
+* ``engine_scene_read``: the scene-read part of that call (bond flags and positions);
+* ``engine_call_count_check``: the whole call with ``bond_check='count'`` and
+  ``geometry_every=0`` (the scene check compares counts only);
+* ``yade_step``: one ``O.step()`` of YADE's mechanics on the same bonded packing, without
+  the engine.
+
+Times are the best of ``--repeat`` (default 5), in ms. Ends with one JSON line.
+
+    yade -n -x bench/bench_coupled.py [--sizes 5000,20000] [--repeat 5]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+# yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
+_SCRIPT = __file__ if __file__.endswith("bench_coupled.py") else (sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_coupled.py") else __file__)
+HERE = os.path.dirname(os.path.abspath(_SCRIPT))
+sys.path.insert(0, os.path.dirname(HERE))
+
+from yade_electro.yade.runtime import import_yade  # noqa: E402
+
+DT = 1e-3           # s, thermal step
+BETA = 1e-3         # 1/K, for the rho_e(T) variant
+
+
+def best(fn, repeat):
+    """Best wall time [s] of ``repeat`` calls of fn (and the last result)."""
+    t_best, out = float("inf"), None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        t_best = min(t_best, time.perf_counter() - t)
+    return t_best, out
+
+
+def bench_size(n, repeat=5, seed=1):
+    yade = import_yade()
+    from yade import pack
+    from yade_electro.coupled import ElectroThermalModel
+    from yade_electro.engine import ElectricalModel
+    from yade_electro.yade import ElectroThermalEngine, SceneReader
+    from yade_electro.yade import packing as P
+    sys.path.insert(0, os.path.join(os.path.dirname(HERE), "cases"))
+    import joule_rod as jr
+    import rod_resistance as rod
+
+    O = yade.Omega()
+    O.reset()
+    packing = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS), n=n, seed=seed)
+    ids = np.asarray(P.add_bonded_packing(packing))
+    r_mean = float(np.mean(packing.radii))
+    bottom, top = rod.end_layers(packing.centers[:, 2], packing.radii, r_mean)
+    graph = SceneReader(O, geometry_every=0).read()
+    out = {"n": int(graph.n_nodes), "n_edges": int(graph.n_edges)}
+    electrodes = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
+                  "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
+
+    def model(theta, beta):
+        el = ElectricalModel(rod.RHO_304L, electrodes)
+        return ElectroThermalModel(el, jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, beta=beta,
+                                   theta=theta)
+
+    for tag, theta in (("be", "backward-euler"), ("explicit", "explicit")):
+        for var, beta in (("unchanged", 0.0), ("rho_T", BETA)):
+            firsts = []
+            for _ in range(max(1, repeat // 2)):
+                m = model(theta, beta)
+                t = time.perf_counter()
+                row = m.step(graph, DT)
+                firsts.append(time.perf_counter() - t)
+            out[f"{tag}_{var}_first_ms"] = min(firsts)
+            m.step(graph, DT)
+            solves = m.n_potential_solves
+            out[f"{tag}_{var}_ms"], row = best(lambda: m.step(graph, DT), repeat)
+            out[f"{tag}_{var}_potential_solves_per_step"] = (m.n_potential_solves - solves) / repeat
+            out[f"{tag}_{var}_substeps"] = int(row["n_substeps"])
+    out["dt_critical_ms"] = m.time_steps()["critical"] * 1e3
+
+    # the engine's whole PyRunner call
+    engine = ElectroThermalEngine(rod.RHO_304L, {"top": dict(select=ids[top], potential=1.0),
+                                                 "bottom": dict(select=ids[bottom], potential=0.0)},
+                                  jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, thermal_dt=DT,
+                                  theta="backward-euler", label="bench_coupled")
+    t = time.perf_counter()
+    engine.step()
+    out["engine_call_first_ms"] = time.perf_counter() - t
+    engine.step()
+    out["engine_call_ms"], _ = best(engine.step, repeat)
+    out["engine_scene_read_ms"], _ = best(engine.reader.read, repeat)     # part of the call
+    engine.remove()
+    # the same with the cheapest unchanged-scene check (counts only, positions not re-read)
+    engine = ElectroThermalEngine(rod.RHO_304L, {"top": dict(select=ids[top], potential=1.0),
+                                                 "bottom": dict(select=ids[bottom], potential=0.0)},
+                                  jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, thermal_dt=DT,
+                                  theta="backward-euler", geometry_every=0, bond_check="count",
+                                  label="bench_coupled_count")
+    engine.step()
+    engine.step()
+    out["engine_call_count_check_ms"], _ = best(engine.step, repeat)
+    engine.remove()
+
+    O.dt = 0.5 * yade.utils.PWaveTimeStep()
+    O.step()
+    out["yade_step_ms"], _ = best(O.step, repeat)
+    for k in list(out):
+        if k.endswith("_ms") and k != "dt_critical_ms":
+            out[k] = round(out[k] * 1e3, 3)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", default="5000,20000")
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    results = [bench_size(int(n), args.repeat) for n in args.sizes.split(",")]
+    keys = [k for k in results[0] if k != "n"]
+    print(f"{'':42s}" + "".join(f"{r['n']:>14d}" for r in results))
+    for k in keys:
+        print(f"{k:42s}" + "".join(f"{r[k]:>14.4g}" if isinstance(r[k], float) else f"{r[k]:>14}" for r in results))
+    print(json.dumps({"bench": "coupled", "dt_s": DT, "beta": BETA, "results": results}))
+
+
+if __name__ == "__main__":
+    main()
