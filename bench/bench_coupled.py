@@ -39,39 +39,24 @@ _SCRIPT = __file__ if __file__.endswith("bench_coupled.py") else (sys.argv[0] if
 HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 sys.path.insert(0, os.path.dirname(HERE))
 
+sys.path.insert(0, HERE)
+from _benchlib import best, bonded_rod  # noqa: E402
 from yade_electro.yade.runtime import import_yade  # noqa: E402
 
 DT = 1e-3           # s, thermal step
 BETA = 1e-3         # 1/K, for the rho_e(T) variant
 
 
-def best(fn, repeat):
-    """Best wall time [s] of ``repeat`` calls of fn (and the last result)."""
-    t_best, out = float("inf"), None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        t_best = min(t_best, time.perf_counter() - t)
-    return t_best, out
-
-
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
-    from yade import pack
     from yade_electro.coupled import ElectroThermalModel
     from yade_electro.engine import ElectricalModel
     from yade_electro.yade import ElectroThermalEngine, SceneReader
     from yade_electro.yade import packing as P
-    sys.path.insert(0, os.path.join(os.path.dirname(HERE), "cases"))
     import joule_rod as jr
     import rod_resistance as rod
 
-    O = yade.Omega()
-    O.reset()
-    packing = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS), n=n, seed=seed)
-    ids = np.asarray(P.add_bonded_packing(packing))
-    r_mean = float(np.mean(packing.radii))
-    bottom, top = rod.end_layers(packing.centers[:, 2], packing.radii, r_mean)
+    O, ids, bottom, top = bonded_rod(n, seed)
     graph = SceneReader(O, geometry_every=0).read()
     out = {"n": int(graph.n_nodes), "n_edges": int(graph.n_edges)}
     electrodes = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),

@@ -151,6 +151,17 @@ def _clipped_by_planes(poly, normal, planes):
     return _area(poly, normal)
 
 
+def _tessellate(pos, radius, ghosts):
+    """Voronoi tessellation of the elements, their ghosts and eight far points (which keep
+    every cell of a real element finite). Returns (all points, scipy Voronoi)."""
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
+    mid = 0.5 * (lo + hi)
+    far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    pts = np.concatenate([pos, ghosts, far])
+    return pts, Voronoi(pts)
+
+
 def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
     """Pairs of neighbouring cells and the areas of their common faces.
 
@@ -170,12 +181,7 @@ def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, thresh
     ghosts, foot, nrm, mirrored = ghost_points(pos, radius, container,
                                                neighbour_barycentre=neighbour_barycentre,
                                                threshold=threshold)
-    lo, hi = pos.min(axis=0), pos.max(axis=0)
-    span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
-    mid = 0.5 * (lo + hi)
-    far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    pts = np.concatenate([pos, ghosts, far])
-    vor = Voronoi(pts)
+    pts, vor = _tessellate(pos, radius, ghosts)
     rp = vor.ridge_points
     keep = (rp[:, 0] < n) & (rp[:, 1] < n)
     idx = np.flatnonzero(keep)
@@ -342,12 +348,7 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
         raise ValueError("voronoi_cell_volumes needs container=<the solid's shape>, an object with sdf(x) "
                          f"and gradient(x); got {container!r}")
     ghosts, _, _, _ = ghost_points(pos, radius, container)
-    lo, hi = pos.min(axis=0), pos.max(axis=0)
-    span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
-    mid = 0.5 * (lo + hi)
-    far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    pts = np.concatenate([pos, ghosts, far])
-    vor = Voronoi(pts)
+    pts, vor = _tessellate(pos, radius, ghosts)
     out = np.asarray(container.sdf(vor.vertices), float) > rel_tol * 2.0 * float(np.min(radius))
     rp = vor.ridge_points
     vol = np.zeros(n)
