@@ -69,6 +69,8 @@ class ElectroThermalModel:
         Default area of convection/flux conditions (else ``thermal.exposed_area``).
     volume_fraction, cell_volume : optional, see :func:`~yade_electro.thermal.heat_capacity`
         Scalars or callables ``f(graph) -> (n,)`` (per-node arrays only fit a fixed graph).
+        Default: paper 000's fv(n) capacities, except with the 'voronoi' law, where the
+        bounded Voronoi cell volumes are used (``voronoi.cell_volume_of(container)``).
     coupling_iterations, coupling_tol : see the module notes.
     resistivity_tol : float
         With beta != 0, re-solve the potential only when some node's resistivity moved by
@@ -102,6 +104,11 @@ class ElectroThermalModel:
         self.heat_options = dict(theta=theta, subcycle=subcycle, safety=safety, max_substeps=max_substeps,
                                  solver=thermal_solver)
         self.fixed, self.flux, self.convection = list(fixed), list(flux), list(convection)
+        if (cell_volume is None and volume_fraction is None and electrical.law == "voronoi"
+                and electrical.law_params.get("container") is not None):
+            # the capacities that go with Voronoi conductances: the cells fill the solid
+            from .voronoi import cell_volume_of
+            cell_volume = cell_volume_of(electrical.law_params["container"])
         self.area, self.volume_fraction, self.cell_volume = area, volume_fraction, cell_volume
         if int(coupling_iterations) < 0:
             raise ValueError("coupling_iterations must be >= 0")
