@@ -110,3 +110,19 @@ def test_area_lookup_of_non_neighbours_is_zero():
     pairs = np.array([[0, 1], [1, 2]])
     f = VoronoiFaces(pairs, np.array([2.0, 3.0]), 4)
     np.testing.assert_array_equal(f.area_of(np.array([[1, 0], [2, 1], [0, 3]])), [2.0, 3.0, 0.0])
+
+
+def test_cells_at_a_re_entrant_corner_are_not_cut_away():
+    """An L-shaped solid (a box minus a box): tangent planes of the concave corner must not
+    cut solid away; every cell keeps a volume and the cells fill the solid."""
+    from yade_electro.voronoi import voronoi_cell_volumes
+    from yade_electro.yade.packing import Box as ShapeBox
+    solid = ShapeBox((0, 0, 0), (2, 2, 1)) - ShapeBox((1, 1, -1), (3, 3, 2))
+    rng = np.random.default_rng(5)
+    pts = rng.uniform([0, 0, 0], [2, 2, 1], size=(3000, 3))
+    pts = pts[np.asarray(solid.sdf(pts)) < -0.02][:600]
+    vol, info = voronoi_cell_volumes(pts, np.full(len(pts), 0.02), solid, return_info=True)
+    assert vol.min() > 0
+    assert vol.sum() == pytest.approx(3.0, rel=2e-3)        # exact L volume: 4 - 1
+    pairs, area = voronoi_faces(pts, np.full(len(pts), 0.02), solid)
+    assert np.all(area >= 0) and np.isfinite(area).all()

@@ -125,10 +125,12 @@ def _clipped_area(poly, normal, container, max_planes=8, rel_tol=1e-2):
     """Area of the part of a planar convex polygon inside the container, clipped by the
     tangent planes at the nearest surface points of the vertices that stick out (exact for
     planar walls; on curved walls vertices may stay outside by ``rel_tol`` times the
-    polygon's size, a tangent-plane error O(h^2 / R))."""
+    polygon's size, a tangent-plane error O(h^2 / R)). A plane that would also remove
+    vertices inside the solid (a re-entrant corner) is not used: the polygon is then
+    measured by sampling."""
     poly = _order(poly, normal)
-    lo = poly.min(axis=0)
-    tol = rel_tol * float(np.linalg.norm(poly.max(axis=0) - lo))
+    size = float(np.linalg.norm(poly.max(axis=0) - poly.min(axis=0)))
+    tol = rel_tol * size
     for _ in range(max_planes):
         if len(poly) < 3:
             return 0.0
@@ -138,8 +140,30 @@ def _clipped_area(poly, normal, container, max_planes=8, rel_tol=1e-2):
             break
         g = np.asarray(container.gradient(poly[k:k + 1]), float)[0]
         g /= np.linalg.norm(g)
-        poly = _clip(poly, poly[k] - d[k] * g, g)
+        foot = poly[k] - d[k] * g
+        removed = (poly - foot) @ g > 1e-12 * size
+        if np.any(d[removed] < -tol):           # a concave corner: the plane would cut solid
+            return _sampled_area(poly, normal, container)
+        poly = _clip(poly, foot, g)
     return _area(poly, normal)
+
+
+def _sampled_area(poly, normal, container, k=16):
+    """Area of the part of an ordered planar convex polygon inside the container, from k^2
+    sub-triangles of each fan triangle (relative error ~ 1/k^2 per cut triangle)."""
+    cen = poly.mean(axis=0)
+    ii, jj = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    up = (ii + jj) < k
+    dn = (ii + jj) < k - 1
+    u = np.concatenate([(ii[up] + 1 / 3) / k, (ii[dn] + 2 / 3) / k])
+    v = np.concatenate([(jj[up] + 1 / 3) / k, (jj[dn] + 2 / 3) / k])
+    total = 0.0
+    for t in range(len(poly)):
+        p1, p2 = poly[t], poly[(t + 1) % len(poly)]
+        tri = 0.5 * abs(np.cross(p1 - cen, p2 - cen) @ normal)
+        x = cen + np.outer(u, p1 - cen) + np.outer(v, p2 - cen)
+        total += tri * np.mean(np.asarray(container.sdf(x), float) <= 0)
+    return total
 
 
 def _clipped_by_planes(poly, normal, planes):
@@ -303,10 +327,31 @@ def _clipped_volume(hs, guess, container, max_planes, rel_tol):
         g = np.asarray(container.gradient(verts[k:k + 1]), float)[0]
         g /= np.linalg.norm(g)
         foot = verts[k] - d[k] * g
+        # the tangent plane may only remove what is outside the solid: at a re-entrant
+        # (concave) corner it would also cut solid away (even the element's own centre);
+        # such a cell is measured by sampling instead
+        removed = (verts - foot) @ g > 1e-12 * size
+        if np.any(d[removed] < -rel_tol * size):
+            return _sampled_volume(hs, verts, container)
         hs = np.vstack([hs, np.append(g, -g @ foot)])
         if container.sdf(guess[None, :])[0] >= -1e-12 * size:   # centre on the wall: move in
             guess = guess - 1e-3 * size * g
     return float(ConvexHull(verts).volume)
+
+
+def _grid(k):
+    """k^3 cell-centred points of the unit cube."""
+    t = (np.arange(k) + 0.5) / k
+    return np.stack(np.meshgrid(t, t, t, indexing="ij"), -1).reshape(-1, 3)
+
+
+def _sampled_volume(hs, verts, container, k=24):
+    """Volume of the convex polytope ``hs`` (vertices ``verts``) inside the container, from a
+    k^3 grid over its bounding box (relative error ~ 1/k at the boundary)."""
+    lo, hi = verts.min(axis=0), verts.max(axis=0)
+    x = lo + _grid(k) * (hi - lo)
+    inside = np.all(x @ hs[:, :3].T + hs[:, 3] <= 0, axis=1) & (np.asarray(container.sdf(x), float) <= 0)
+    return float(np.prod(hi - lo) * inside.mean())
 
 
 def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: float = 1e-4,
