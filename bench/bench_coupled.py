@@ -32,7 +32,6 @@ import os
 import sys
 import time
 
-import numpy as np
 
 # yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
 _SCRIPT = __file__ if __file__.endswith("bench_coupled.py") else (sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_coupled.py") else __file__)
@@ -52,7 +51,6 @@ def bench_size(n, repeat=5, seed=1):
     from yade_electro.coupled import ElectroThermalModel
     from yade_electro.engine import ElectricalModel
     from yade_electro.yade import ElectroThermalEngine, SceneReader
-    from yade_electro.yade import packing as P
     import joule_rod as jr
     import rod_resistance as rod
 

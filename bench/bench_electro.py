@@ -15,7 +15,6 @@ import os
 import sys
 import time
 
-import numpy as np
 
 # yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
 _SCRIPT = __file__ if __file__.endswith("bench_electro.py") else (sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_electro.py") else __file__)

@@ -88,6 +88,7 @@ if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
 import rod_resistance as rod  # noqa: E402
+from caselib import apply_batch_table  # noqa: E402
 from yade_electro.yade.runtime import import_yade  # noqa: E402
 
 DENSITY = 7900.0        # kg/m^3 (304L, paper 000 Table II)
@@ -261,12 +262,7 @@ def _params(argv):
     ap.add_argument("--voltage", type=float, default=VOLTAGE)
     ap.add_argument("--out", default="out/joule_rod")
     args = ap.parse_args(argv)
-    if os.environ.get("YADE_BATCH"):    # run by yade-batch: the table line gives the parameters
-        from yade import utils
-        utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.laws.split(",")[0], noTableOk=True)
-        from yade.params import table
-        args.n, args.seed, args.laws = int(table.n), int(table.seed), str(table.law)
-    return args
+    return apply_batch_table(args, attrs={"law": "laws"})   # under yade-batch: n, seed, law
 
 
 def main(argv=None):

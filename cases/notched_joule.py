@@ -91,6 +91,9 @@ _SCRIPT = __file__ if __file__.endswith(_NAME) else (
 HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, os.path.dirname(HERE))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+from caselib import apply_batch_table, collect_runs  # noqa: E402
 
 LENGTH = 6e-3          # m, x (electrodes at x = 0 and x = L)
 WIDTH = 1.1e-3         # m, y (notches from y = 0 and y = WIDTH)
@@ -487,17 +490,7 @@ def sweep(sizes=SIZES, laws=LAWS, seed=1, out_dir="out/notched_joule", hs=FEM_HS
 def collect(out_dir):
     """Rows of every ``notched_n*_s*_*.json`` in ``out_dir`` (sorted by n, law), written to
     ``notched_joule.csv`` with the sweep plot ``notched_joule.png`` there. Returns the rows."""
-    import glob
-    rows = []
-    for path in glob.glob(os.path.join(out_dir, "notched_n*_s*_*.json")):
-        with open(path) as fh:
-            rows.append(json.load(fh))
-    rows.sort(key=lambda r: (r["n"], r["seed"], LAWS.index(r["law"]) if r["law"] in LAWS else 9))
-    with open(os.path.join(out_dir, "notched_joule.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for r in rows:
-            w.writerow(r)
+    rows = collect_runs(out_dir, "notched_n*_s*_*.json", "notched_joule.csv", CSV_FIELDS, LAWS)
     if rows:
         plot_sweep(rows, os.path.join(out_dir, "notched_joule.png"))
     return rows
@@ -521,12 +514,7 @@ def _params(argv):
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/notched_joule")
     args = ap.parse_args(argv)
-    if os.environ.get("YADE_BATCH"):    # run by yade-batch: the table line gives the parameters
-        from yade import utils
-        utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.law, noTableOk=True)
-        from yade.params import table
-        args.n, args.seed, args.law = int(table.n), int(table.seed), str(table.law)
-    return args
+    return apply_batch_table(args)      # under yade-batch, the table line gives n, seed, law
 
 
 def main(argv=None):

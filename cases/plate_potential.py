@@ -69,7 +69,6 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
 import os
 import sys
 import time
@@ -83,6 +82,9 @@ _SCRIPT = __file__ if __file__.endswith(_NAME) else (
 HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, os.path.dirname(HERE))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+from caselib import apply_batch_table, collect_runs  # noqa: E402
 
 WIDTH = 25e-3          # m, x
 HEIGHT = 25e-3         # m, y (ground at y = 0)
@@ -391,24 +393,14 @@ def summary_line(row) -> str:
 def collect(out_dir):
     """Rows of every ``plate_n*_s*_*.json`` in ``out_dir`` (sorted by n, law), written to
     ``plate_potential.csv`` with the sweep plot ``plate_potential.png`` there. Returns the rows."""
-    import glob
-    rows = []
-    for path in glob.glob(os.path.join(out_dir, "plate_n*_s*_*.json")):
-        with open(path) as fh:
-            rows.append(json.load(fh))
-    rows.sort(key=lambda r: (r["n"], r["seed"], LAWS.index(r["law"]) if r["law"] in LAWS else 9))
-    with open(os.path.join(out_dir, "plate_potential.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for r in rows:
-            w.writerow(r)
+    rows = collect_runs(out_dir, "plate_n*_s*_*.json", "plate_potential.csv", CSV_FIELDS, LAWS)
     if rows:
         plot_sweep(rows, os.path.join(out_dir, "plate_potential.png"))
     return rows
 
 
 def _params(argv):
-    """Parameters from a yade-batch table (PARAM_TABLE set) or from the command line."""
+    """Parameters from the command line, or from a yade-batch table line."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=1)
@@ -427,12 +419,7 @@ def _params(argv):
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/plate_potential")
     args = ap.parse_args(argv)
-    if os.environ.get("YADE_BATCH"):    # run by yade-batch: the table line gives the parameters
-        from yade import utils
-        utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.law, noTableOk=True)
-        from yade.params import table
-        args.n, args.seed, args.law = int(table.n), int(table.seed), str(table.law)
-    return args
+    return apply_batch_table(args)      # under yade-batch, the table line gives n, seed, law
 
 
 def main(argv=None):

@@ -39,6 +39,9 @@ _SCRIPT = __file__ if __file__.endswith("rod_resistance.py") else (sys.argv[0] i
 HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, os.path.dirname(HERE))
+if HERE not in sys.path:
+    sys.path.insert(0, HERE)
+from caselib import apply_batch_table  # noqa: E402
 
 from yade_electro.yade.runtime import import_yade  # noqa: E402
 
@@ -193,7 +196,7 @@ def plot_sweep(rows, path):
 
 
 def _params(argv):
-    """Parameters from a yade-batch table (PARAM_TABLE set) or from the command line."""
+    """Parameters from the command line, or from a yade-batch table line."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=1)
@@ -206,12 +209,7 @@ def _params(argv):
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/rod_resistance")
     args = ap.parse_args(argv)
-    if os.environ.get("YADE_BATCH"):    # run by yade-batch: the table line gives the parameters
-        from yade import utils
-        utils.readParamsFromTable(n=args.n, seed=args.seed, law=args.law, noTableOk=True)
-        from yade.params import table
-        args.n, args.seed, args.law = int(table.n), int(table.seed), str(table.law)
-    return args
+    return apply_batch_table(args)      # under yade-batch, the table line gives n, seed, law
 
 
 def main(argv=None):

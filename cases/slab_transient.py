@@ -143,7 +143,6 @@ class SlabModel:
     def limits(self) -> dict:
         """Explicit step limits [s]: ``bound`` = min C_i / sum G (HeatSolver), ``true`` = 2 /
         lambda_max of C^-1 M on the free nodes, ``paper`` = l_min^2 / (2 alpha)."""
-        import scipy.sparse as sp
         from yade_electro.network import laplacian
         heat = self.solver(0.0)
         u = ~self.fixed
@@ -268,7 +267,6 @@ def plot(model, results, stab, path):
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.3))
     ax = axes[0]
     xs = np.linspace(0, model.length, 200)
-    free = ~model.fixed
     first = model.graph.pos[:, 1] < model.h        # one element per layer (the section is uniform)
     first &= model.graph.pos[:, 2] < model.h
     be = results["backward-euler 100x"]["profiles"]

@@ -1,0 +1,44 @@
+"""Pieces every case script shares: yade-batch parameters and gathering per-run results.
+
+Not a case itself (no JSON line); imported by the scripts in this folder.
+"""
+from __future__ import annotations
+
+import csv
+import glob
+import json
+import os
+
+
+def apply_batch_table(args, columns=("n", "seed", "law"), attrs=None):
+    """When the script runs under yade-batch (``YADE_BATCH`` set), overwrite ``args`` with the
+    table line's values of ``columns`` (YADE eval()s the cells, so strings are quoted in the
+    table). ``attrs`` maps a column to the argparse attribute when their names differ.
+    The command-line values are the defaults of columns the table lacks."""
+    if not os.environ.get("YADE_BATCH"):
+        return args
+    attrs = dict(attrs or {})
+    from yade import utils
+    defaults = {c: getattr(args, attrs.get(c, c)) for c in columns}
+    utils.readParamsFromTable(noTableOk=True, **defaults)
+    from yade.params import table
+    for c in columns:
+        setattr(args, attrs.get(c, c), type(defaults[c])(getattr(table, c)))
+    return args
+
+
+def collect_runs(out_dir, pattern, csv_name, fields, laws=()):
+    """Rows of every per-run JSON file matching ``pattern`` in ``out_dir``, sorted by (n, seed,
+    law in the order of ``laws``) and written to ``csv_name`` there with ``fields``."""
+    rows = []
+    for path in glob.glob(os.path.join(out_dir, pattern)):
+        with open(path) as fh:
+            rows.append(json.load(fh))
+    order = {law: k for k, law in enumerate(laws)}
+    rows.sort(key=lambda r: (r["n"], r["seed"], order.get(r["law"], len(order))))
+    with open(os.path.join(out_dir, csv_name), "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    return rows
