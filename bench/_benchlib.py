@@ -37,3 +37,31 @@ def bonded_rod(n, seed=1):
     ids = np.asarray(P.add_bonded_packing(packing))
     bottom, top = rod.end_layers(packing.centers[:, 2], packing.radii, float(np.mean(packing.radii)))
     return O, ids, bottom, top
+
+
+def to_ms(out, keep=()):
+    """Convert the ``*_ms`` entries of ``out`` (measured in s) to ms, rounded; ``keep``
+    names entries already in ms."""
+    for k in list(out):
+        if k.endswith("_ms") and k not in keep:
+            out[k] = round(out[k] * 1e3, 3)
+    return out
+
+
+def run_sizes(bench_size, name, argv=None, **extra):
+    """Parse ``--sizes``/``--repeat``, run ``bench_size(n, repeat)`` for each size, print the
+    table (one column per size) and one JSON line ``{"bench": name, **extra, "results": [...]}``."""
+    import argparse
+    import json
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", default="5000,20000")
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    results = [bench_size(int(n), args.repeat) for n in args.sizes.split(",")]
+    width = max(len(k) for k in results[0]) + 2
+    print(f"{'':{width}s}" + "".join(f"{r['n']:>14d}" for r in results))
+    for k in (k for k in results[0] if k != "n"):
+        print(f"{k:{width}s}" + "".join(f"{r[k]:>14.4g}" if isinstance(r[k], float) else f"{r[k]:>14}"
+                                         for r in results))
+    print(json.dumps({"bench": name, **extra, "results": results}))
+    return results

@@ -26,8 +26,6 @@ Times are the best of ``--repeat`` (default 5), in ms. Ends with one JSON line.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import sys
 import time
@@ -39,7 +37,7 @@ HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 sys.path.insert(0, os.path.dirname(HERE))
 
 sys.path.insert(0, HERE)
-from _benchlib import best, bonded_rod  # noqa: E402
+from _benchlib import best, bonded_rod, run_sizes, to_ms  # noqa: E402
 from yade_electro.yade.runtime import import_yade  # noqa: E402
 
 DT = 1e-3           # s, thermal step
@@ -107,23 +105,11 @@ def bench_size(n, repeat=5, seed=1):
     O.dt = 0.5 * yade.utils.PWaveTimeStep()
     O.step()
     out["yade_step_ms"], _ = best(O.step, repeat)
-    for k in list(out):
-        if k.endswith("_ms") and k != "dt_critical_ms":
-            out[k] = round(out[k] * 1e3, 3)
-    return out
+    return to_ms(out, keep=("dt_critical_ms",))
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--sizes", default="5000,20000")
-    ap.add_argument("--repeat", type=int, default=5)
-    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    results = [bench_size(int(n), args.repeat) for n in args.sizes.split(",")]
-    keys = [k for k in results[0] if k != "n"]
-    print(f"{'':42s}" + "".join(f"{r['n']:>14d}" for r in results))
-    for k in keys:
-        print(f"{k:42s}" + "".join(f"{r[k]:>14.4g}" if isinstance(r[k], float) else f"{r[k]:>14}" for r in results))
-    print(json.dumps({"bench": "coupled", "dt_s": DT, "beta": BETA, "results": results}))
+    return run_sizes(bench_size, "coupled", argv, dt_s=DT, beta=BETA)
 
 
 if __name__ == "__main__":
