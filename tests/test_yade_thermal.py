@@ -88,3 +88,31 @@ def test_non_finite_temperatures_stop_and_keep_the_history(run_yade_script, tmp_
     assert all(float(v) == float(v) and abs(float(v)) != float("inf")
                for r in rows for k, v in r.items() if k not in ("graph_revision",))
     assert 293.15 <= out["body_T_min"] <= out["body_T_max"] < 1e4
+
+
+BCS = SCENE + r'''
+from yade_electro.thermal import FixedTemperature, Convection
+e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.05), "bottom": dict(select=BOTTOM, potential=0.0)},
+                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
+                         fixed=[FixedTemperature("cold end", BOTTOM, 293.15)],
+                         convection=[Convection("air", pack.inAlignedBox((-1, -1, -1), (1, 1, 1)), h=1e5, t_inf=293.15)],
+                         thermal_dt=1e-3, iterPeriod=1, history="bcs.csv")
+O.engines = O.engines + [e.runner]
+O.run(20, True)
+bottom_T = [b.state.temp for b in O.bodies if BOTTOM(tuple(b.state.pos), 0)]
+last = e.history.rows[-1]
+print(json.dumps(dict(bottom=[min(bottom_T), max(bottom_T)], joule=last["joule_energy"], heat=last["heat_content"],
+                      absorbed=last["absorbed_heat"], boundary=last["boundary_heat"],
+                      convection=last["convection_heat"], flux=last["flux_heat"], T_max=last["T_max"])))
+'''
+
+
+def test_boundary_conditions_selected_by_predicates(run_yade_script, tmp_path):
+    out = run_yade_script(BCS, timeout=120, cwd=tmp_path, check=True).result
+    assert out["bottom"] == [293.15, 293.15]                 # held by the fixed-temperature set
+    assert out["heat"] < out["joule"]                        # heat leaves through both conditions
+    # the history closes the energy balance: stored = Joule - absorbed by the thermostat
+    # + received from the fixed elements + from the ambient + from fluxes (received < 0 here)
+    assert out["heat"] == pytest.approx(out["joule"] - out["absorbed"] + out["boundary"] + out["convection"]
+                                        + out["flux"], rel=1e-9)
+    assert out["convection"] < 0 and out["boundary"] < 0 and out["absorbed"] > 0 and out["flux"] == 0

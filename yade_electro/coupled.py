@@ -253,8 +253,13 @@ class ElectroThermalModel:
 
     def summary(self, step=None, power=None) -> dict:
         """History row: time, dt, current, voltage, R_eq, joule_power [W] (of the last step),
-        joule_energy [J] (cumulative), heat_content [J], boundary_heat, convection_heat [J]
-        (cumulative), T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves."""
+        joule_energy [J] (cumulative), heat_content [J], and, cumulative [J]: absorbed_heat
+        (Joule heat generated on fixed-temperature elements, taken by their thermostat),
+        boundary_heat, convection_heat, flux_heat (heat *received* by the solid from the
+        fixed-temperature elements, the ambient and imposed fluxes: negative when it leaves);
+        then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves.
+        Balance: heat_content change = joule_energy - absorbed_heat + boundary_heat +
+        convection_heat + flux_heat."""
         sol, el, heat = self.solution, self.electrical, self.heat
         names = list(sol.electrode_current)
         a, b = el.measure if el.measure else (names[0], None)
@@ -268,8 +273,10 @@ class ElectroThermalModel:
             "joule_power": float(np.sum(self.sources)) if power is None else power,
             "joule_energy": self.joule_energy,
             "heat_content": float(np.sum(C * (T - self.T0))),
+            "absorbed_heat": heat.energy["absorbed"],
             "boundary_heat": heat.energy["boundary"],
             "convection_heat": heat.energy["convection"],
+            "flux_heat": heat.energy["flux"],
             "T_mean": float(np.sum(C * T) / np.sum(C)),
             "T_max": float(np.max(T)),
             "T_min": float(np.min(T)),
