@@ -106,9 +106,9 @@ class ElectroThermalModel:
         self.fixed, self.flux, self.convection = list(fixed), list(flux), list(convection)
         if (cell_volume is None and volume_fraction is None and electrical.law == "voronoi"
                 and electrical.law_params.get("container") is not None):
-            # the capacities that go with Voronoi conductances: the cells fill the solid
-            from .voronoi import cell_volume_of
-            cell_volume = cell_volume_of(electrical.law_params["container"])
+            # the capacities that go with Voronoi conductances: the cells fill the solid,
+            # from the tessellation the electrical law already made for this element set
+            cell_volume = self._voronoi_cells
         self.area, self.volume_fraction, self.cell_volume = area, volume_fraction, cell_volume
         if int(coupling_iterations) < 0:
             raise ValueError("coupling_iterations must be >= 0")
@@ -129,6 +129,15 @@ class ElectroThermalModel:
         self._values: dict = {}
         self.solution = None
         self.sources = None
+
+    def _voronoi_cells(self, graph: ContactGraph) -> np.ndarray:
+        """Bounded Voronoi cell volumes of ``graph``'s elements, from the electrical law's
+        cached tessellation (prepared for this graph just before)."""
+        faces = self.electrical._law_cache.get("faces")
+        if faces is None or faces.n != graph.n_nodes:
+            from .voronoi import voronoi_cell_volumes
+            return voronoi_cell_volumes(graph.pos, graph.radius, self.electrical.law_params["container"])
+        return faces.cell_volumes()
 
     # -- structure ---------------------------------------------------------------------------
     @staticmethod

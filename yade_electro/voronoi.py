@@ -186,7 +186,8 @@ def _tessellate(pos, radius, ghosts):
     return pts, Voronoi(pts)
 
 
-def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
+def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4,
+                  return_tessellation=False):
     """Pairs of neighbouring cells and the areas of their common faces.
 
     Parameters
@@ -199,6 +200,8 @@ def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, thresh
     -------
     pairs : (p, 2) int array, i < j, both real elements
     area : (p,) face areas [m^2] (clipped to the container when one is given)
+    tessellation : (points, scipy Voronoi), with ``return_tessellation`` (for
+        :func:`voronoi_cell_volumes`, so one tessellation serves both)
     """
     pos = np.asarray(pos, float)
     n = pos.shape[0]
@@ -229,6 +232,8 @@ def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, thresh
             planes = [plane_of[q] for q in (int(i), int(j)) if q in plane_of]
             if planes:
                 area[m] = _clipped_by_planes(vor.vertices[rv[m]], normals[m], planes)
+    if return_tessellation:
+        return pairs, area, (pts, vor)
     return pairs, area
 
 
@@ -249,8 +254,20 @@ class VoronoiFaces:
 
     @classmethod
     def of(cls, graph, container):
-        pairs, area = voronoi_faces(graph.pos, graph.radius, container)
-        return cls(pairs, area, graph.n_nodes)
+        """Faces of ``graph``'s elements in ``container``; the tessellation is kept so that
+        :meth:`cell_volumes` does not make it again."""
+        pairs, area, tess = voronoi_faces(graph.pos, graph.radius, container, return_tessellation=True)
+        faces = cls(pairs, area, graph.n_nodes)
+        faces._geometry = (graph.pos, graph.radius, container, tess)
+        return faces
+
+    def cell_volumes(self) -> np.ndarray:
+        """Bounded cell volumes [m^3] of the elements (see :func:`voronoi_cell_volumes`),
+        from the kept tessellation; computed once."""
+        if getattr(self, "_volumes", None) is None:
+            pos, radius, container, tess = self._geometry
+            self._volumes = voronoi_cell_volumes(pos, radius, container, tessellation=tess)
+        return self._volumes
 
     def area_of(self, edges) -> np.ndarray:
         """Face area of each (i, j) edge; 0 where i and j are not Voronoi neighbours."""
@@ -355,7 +372,7 @@ def _sampled_volume(hs, verts, container, k=24):
 
 
 def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: float = 1e-4,
-                         return_info: bool = False):
+                         return_info: bool = False, tessellation=None):
     """Volumes [m^3] of the Voronoi cells of the element centres, bounded by the container:
     the volume of solid each element stands for (heat capacity ``rho c V_cell``).
 
@@ -381,6 +398,9 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
     return_info : bool
         Also return a dict: ``total`` (sum of the volumes), ``container_volume`` (exact if
         the container knows it, else None), ``relative_excess`` and ``n_clipped``.
+    tessellation : (points, scipy Voronoi), optional
+        The one :func:`voronoi_faces` made for the same elements and container (its
+        ``return_tessellation``), to avoid making it twice.
 
     Returns
     -------
@@ -392,8 +412,11 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
     if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
         raise ValueError("voronoi_cell_volumes needs container=<the solid's shape>, an object with sdf(x) "
                          f"and gradient(x); got {container!r}")
-    ghosts, _, _, _ = ghost_points(pos, radius, container)
-    pts, vor = _tessellate(pos, radius, ghosts)
+    if tessellation is None:
+        ghosts, _, _, _ = ghost_points(pos, radius, container)
+        pts, vor = _tessellate(pos, radius, ghosts)
+    else:
+        pts, vor = tessellation
     out = np.asarray(container.sdf(vor.vertices), float) > rel_tol * 2.0 * float(np.min(radius))
     rp = vor.ridge_points
     vol = np.zeros(n)
