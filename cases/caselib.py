@@ -42,3 +42,30 @@ def collect_runs(out_dir, pattern, csv_name, fields, laws=()):
         for r in rows:
             w.writerow(r)
     return rows
+
+
+def public(row):
+    """A result row without its private entries (keys starting with '_'), arrays as lists:
+    what goes to JSON and CSV."""
+    import numpy as np
+    return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in row.items()
+            if not k.startswith("_")}
+
+
+def sweep_runs(run_one, sizes, laws, out_dir, csv_name, fields, summary_line):
+    """``run_one(n, law)`` for every size x law; each row is appended to ``csv_name`` in
+    ``out_dir`` as it comes (so a crash keeps the rows done) and its summary line printed.
+    Returns the rows."""
+    os.makedirs(out_dir, exist_ok=True)
+    rows = []
+    with open(os.path.join(out_dir, csv_name), "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for n in sizes:
+            for law in laws:
+                row = run_one(n, law)
+                rows.append(row)
+                w.writerow(public(row))
+                fh.flush()
+                print(summary_line(row), flush=True)
+    return rows

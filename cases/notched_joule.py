@@ -75,7 +75,6 @@ JSON. Importable (``run_notched``, ``fem_reference``) by the tests.
 from __future__ import annotations
 
 import argparse
-import csv
 import functools
 import json
 import os
@@ -93,7 +92,7 @@ if os.path.dirname(HERE) not in sys.path:  # run from a checkout without install
     sys.path.insert(0, os.path.dirname(HERE))
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
-from caselib import apply_batch_table, collect_runs  # noqa: E402
+from caselib import apply_batch_table, collect_runs, public, sweep_runs  # noqa: E402
 
 LENGTH = 6e-3          # m, x (electrodes at x = 0 and x = L)
 WIDTH = 1.1e-3         # m, y (notches from y = 0 and y = WIDTH)
@@ -345,11 +344,6 @@ def compare(row, ref, ref_off=None):
     return row
 
 
-def public(row):
-    return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in row.items()
-            if not k.startswith("_")}
-
-
 def write_profiles(row, path):
     cols = {"x": row["_x"], "n_elements": row["_bin_count"], "V_dem": row["_V_profile"],
             "V_fem": row["_V_profile_fem"], "T_dem": row["_T_profile"], "T_fem": row["_T_profile_fem"]}
@@ -471,18 +465,9 @@ def summary_line(row) -> str:
 
 
 def sweep(sizes=SIZES, laws=LAWS, seed=1, out_dir="out/notched_joule", hs=FEM_HS, **kw):
-    os.makedirs(out_dir, exist_ok=True)
-    rows = []
-    with open(os.path.join(out_dir, "notched_joule.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for n in sizes:
-            for law in laws:
-                row = run_one(n, seed, law, out_dir, hs, **kw)
-                rows.append(row)
-                w.writerow(public(row))
-                fh.flush()
-                print(summary_line(row), flush=True)
+    """Every size x law; writes notched_joule.csv and notched_joule.png. Returns the rows."""
+    rows = sweep_runs(lambda n, law: run_one(n, seed, law, out_dir, hs, **kw), sizes, laws, out_dir,
+                      "notched_joule.csv", CSV_FIELDS, summary_line)
     plot_sweep(rows, os.path.join(out_dir, "notched_joule.png"))
     return rows
 

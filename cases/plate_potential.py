@@ -67,7 +67,6 @@ JSON. Importable (``run_plate``, ``fem_reference``, ``control_point_value``) by 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -84,7 +83,7 @@ if os.path.dirname(HERE) not in sys.path:  # run from a checkout without install
     sys.path.insert(0, os.path.dirname(HERE))
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
-from caselib import apply_batch_table, collect_runs  # noqa: E402
+from caselib import apply_batch_table, collect_runs, public, sweep_runs  # noqa: E402
 
 WIDTH = 25e-3          # m, x
 HEIGHT = 25e-3         # m, y (ground at y = 0)
@@ -262,11 +261,6 @@ def field_errors(row, offset_too=True):
     return row
 
 
-def public(row):
-    """The row without the private arrays."""
-    return {k: v for k, v in row.items() if not k.startswith("_")}
-
-
 def plot_field(row, path):
     """Element potentials against the FEM at the element centres (parity), and the map."""
     import matplotlib
@@ -364,18 +358,8 @@ def run_one(n, seed, law, out_dir, hs=FEM_HS, offset=True, plot=True, **kw):
 
 def sweep(sizes=SIZES, laws=LAWS, seed=1, out_dir="out/plate_potential", hs=FEM_HS, **kw):
     """Every size x law; writes plate_potential.csv and plate_potential.png. Returns the rows."""
-    os.makedirs(out_dir, exist_ok=True)
-    rows = []
-    with open(os.path.join(out_dir, "plate_potential.csv"), "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS, extrasaction="ignore")
-        w.writeheader()
-        for n in sizes:
-            for law in laws:
-                row = run_one(n, seed, law, out_dir, hs, **kw)
-                rows.append(row)
-                w.writerow(public(row))
-                fh.flush()
-                print(summary_line(row), flush=True)
+    rows = sweep_runs(lambda n, law: run_one(n, seed, law, out_dir, hs, **kw), sizes, laws, out_dir,
+                      "plate_potential.csv", CSV_FIELDS, summary_line)
     plot_sweep(rows, os.path.join(out_dir, "plate_potential.png"))
     return rows
 
