@@ -246,7 +246,7 @@ class ElectricalModel:
         for name in sol.electrode_current:
             row[f"V_{name}"] = sol.electrode_potential[name]
             row[f"I_{name}"] = sol.electrode_current[name]
-        row["joule_power"] = float(np.sum(sol.branch_current ** 2 / np.where(self.conductance > 0, self.conductance, np.inf)))
+        row["joule_power"] = float(np.sum(sol.joule_power(self.conductance)))
         row["n_nodes"] = int(self.graph.n_nodes)
         row["n_edges"] = int(self.graph.n_edges)
         row["n_floating"] = int(sol.floating.sum())

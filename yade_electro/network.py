@@ -38,7 +38,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .errors import BoundaryConditionError, MaterialError, SolverError
 
-__all__ = ["Electrode", "PotentialSolution", "ConductionProblem", "laplacian", "solve_potential",
+__all__ = ["Electrode", "PotentialSolution", "ConductionProblem", "laplacian", "solve_potential", "edge_power",
            "equivalent_resistance", "make_solver", "DirectSolver", "CGSolver", "solver_names"]
 
 log = logging.getLogger(__name__)
@@ -324,12 +324,18 @@ class PotentialSolution:
         return dv / i
 
     def joule_power(self, conductance) -> np.ndarray:
-        """Power dissipated in each edge, w^2 / c [W]."""
-        c = np.asarray(conductance, dtype=float)
-        out = np.zeros_like(c)
-        nz = c > 0
-        out[nz] = self.branch_current[nz] ** 2 / c[nz]
-        return out
+        """Power dissipated in each edge, w^2 / c [W] (see :func:`edge_power`)."""
+        return edge_power(self.branch_current, conductance)
+
+
+def edge_power(branch_current, conductance) -> np.ndarray:
+    """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
+    carry no current)."""
+    c = np.asarray(conductance, dtype=float)
+    out = np.zeros_like(c)
+    nz = c > 0
+    out[nz] = np.asarray(branch_current, dtype=float)[nz] ** 2 / c[nz]
+    return out
 
 
 # ---------------------------------------------------------------------------------------

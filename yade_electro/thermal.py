@@ -51,7 +51,7 @@ import scipy.sparse as sp
 from .conductance import conductance
 from .errors import BoundaryConditionError, MaterialError, ThermalError
 from .graph import ContactGraph
-from .network import laplacian, make_solver
+from .network import edge_power, laplacian, make_solver
 from .surfaces import eccentricity, volume_fraction as _volume_fraction
 
 __all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
@@ -158,10 +158,7 @@ def edge_joule_power(branch_current, conductance, eta: float = 1.0) -> np.ndarra
     if w.shape != c.shape or w.ndim != 1:
         raise ValueError(f"branch_current and conductance must be (m,) arrays of one shape, got {w.shape} "
                          f"and {c.shape}")
-    p = np.zeros_like(c)
-    nz = c > 0
-    p[nz] = eta * w[nz] ** 2 / c[nz]
-    return p
+    return eta * edge_power(w, c)
 
 
 def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float = 1.0) -> np.ndarray:
