@@ -257,6 +257,7 @@ class ElectroThermalEngine(ElectricalEngine):
                                            beta=beta, eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1],
                                            convection=bcs[2], **(coupled_options or {}))
         self._last_time = float(self.O.time)
+        self._states_checked = -1
 
     def step(self):
         """One coupled step on the current scene (what the PyRunner calls)."""
@@ -275,7 +276,9 @@ class ElectroThermalEngine(ElectricalEngine):
             row = self.coupled.step(graph, dt, self.values or None)
         self._last_time = float(self.O.time)
         bodies = self.reader.bodies
-        ensure_thermal_state(bodies)
+        if self._states_checked != self.reader.full_reads:    # the body set changes only there
+            ensure_thermal_state(bodies)
+            self._states_checked = self.reader.full_reads
         for b, t in zip(bodies, self.coupled.temperature.tolist()):
             b.state.temp = t
         if self.write_back:
