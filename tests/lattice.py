@@ -72,3 +72,16 @@ def node_class(shape):
     ijk = lattice_coords(shape)
     on = (ijk == 0) | (ijk == np.asarray(shape) - 1)
     return on.sum(axis=1)
+
+
+def end_selectors(shape, r=1.0):
+    """Selectors ``f(pos, radius) -> mask`` of the bottom (z = 0) and top layers of a
+    lattice rod built by :func:`cubic_lattice` with this shape and radius (origin 0)."""
+    z_top = 2 * r * (shape[2] - 1)
+
+    def bottom(pos, radius):
+        return pos[:, 2] < r
+
+    def top(pos, radius):
+        return pos[:, 2] > z_top - r
+    return bottom, top

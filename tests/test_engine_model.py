@@ -9,20 +9,14 @@ from yade_electro import BoundaryConditionError, MaterialError, conductance, equ
 from yade_electro.engine import ElectricalModel, ElectrodeSpec, History, select_nodes
 from yade_electro.network import CGSolver
 
-from lattice import cubic_lattice
+from lattice import cubic_lattice, end_selectors
 
 R, RHO = 0.5e-3, 0.73e-6
 SHAPE = (3, 3, 8)
 LAYER = SHAPE[0] * SHAPE[1]
 Z_TOP = 2 * R * (SHAPE[2] - 1)
 
-
-def bottom(pos, radius):
-    return pos[:, 2] < R
-
-
-def top(pos, radius):
-    return pos[:, 2] > Z_TOP - R
+bottom, top = end_selectors(SHAPE, R)
 
 
 def rod():

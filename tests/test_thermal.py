@@ -27,7 +27,7 @@ from yade_electro.thermal import (Convection, FixedTemperature, HeatFlux, HeatSo
                                   edge_joule_power, electrical_power, exposed_area, heat_capacity,
                                   joule_sources, stable_time_step, thermal_conductance, theta_of)
 
-from lattice import cubic_lattice, node_class
+from lattice import cubic_lattice, end_selectors, node_class
 
 # 304L steel (paper 000, table II)
 R, RHO_E = 0.5e-3, 0.73e-6
@@ -35,13 +35,7 @@ DENSITY, SPECIFIC_HEAT, LAMBDA = 7900.0, 500.0, 15.0
 SHAPE = (3, 3, 8)
 Z_TOP = 2 * R * (SHAPE[2] - 1)
 
-
-def bottom(pos, radius):
-    return pos[:, 2] < R
-
-
-def top(pos, radius):
-    return pos[:, 2] > Z_TOP - R
+bottom, top = end_selectors(SHAPE, R)
 
 
 def rod():
