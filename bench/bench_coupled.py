@@ -47,7 +47,7 @@ BETA = 1e-3         # 1/K, for the rho_e(T) variant
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade_electro.coupled import ElectroThermalModel
-    from yade_electro.engine import ElectricalModel
+    from yade_electro.electrical import ElectricalModel
     from yade_electro.yade import ElectroThermalEngine, SceneReader
     import joule_rod as jr
     import rod_resistance as rod

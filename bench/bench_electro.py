@@ -28,7 +28,8 @@ def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade import pack
     from yade_electro.conductance import conductance
-    from yade_electro.network import ConductionProblem, Electrode, make_solver
+    from yade_electro.network import ConductionProblem, Electrode
+    from yade_electro.solvers import make_solver
     from yade_electro.yade import SceneReader
     from yade_electro.yade import packing as P
     import rod_resistance as rod
@@ -75,7 +76,7 @@ def bench_size(n, repeat=5, seed=1):
         out[f"{name}_residual"] = sol.residual
 
     # the 'voronoi' law: tessellation (once), then a rebuild after a bond broke
-    from yade_electro.engine import ElectricalModel
+    from yade_electro.electrical import ElectricalModel
     el = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
           "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
     model = ElectricalModel(rod.RHO_304L, el, law="voronoi",

@@ -64,7 +64,10 @@ def plots(pk, k, outdir):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     edges = P.bond_pairs(pk.centers, pk.radii, k)
-    e, deg = P._eccentricity(pk.centers, pk.radii, edges)
+    from yade_electro.graph import ContactGraph
+    from yade_electro.surfaces import eccentricity
+    graph = ContactGraph(pk.centers, pk.radii, edges)
+    e, deg = eccentricity(graph), graph.degree
     os.makedirs(outdir, exist_ok=True)
     tag = f"rod{pk.n}"
     fig, ax = plt.subplots(figsize=(5, 3.5))

@@ -3,9 +3,8 @@ conductance-law registry, against exact values."""
 import numpy as np
 import pytest
 
-from yade_electro import (ContactGraph, MaterialError, conductance, conductance_laws,
-                          register_conductance_law)
-from yade_electro.conductance import _LAWS, contact_radius
+from yade_electro import ContactGraph, MaterialError, conductance_laws, register_conductance_law
+from yade_electro.conductance import ConductanceLaw, conductance, contact_radius, unregister_conductance_law
 from yade_electro.surfaces import (POLYHEDRON_ALPHA, POLYHEDRON_FACES, POLYHEDRON_FV,
                                    eccentricity, eccentricity_factor, edge_transmission_surface,
                                    polyhedron_alpha, polyhedron_volume_fraction,
@@ -183,8 +182,13 @@ def test_register_a_law_and_refuse_a_duplicate_name():
     name = "test-constant"
     try:
         @register_conductance_law(name)
-        def constant(graph, rho, value=1.0):
-            return np.full(graph.n_edges, value / float(rho))
+        class Constant(ConductanceLaw):
+            def __init__(self, value=1.0):
+                self.value = value
+
+            def factor(self, graph, edges=None):
+                return np.full(len(self._edges(graph, edges)), self.value)
+        constant = Constant
         assert name in conductance_laws()
         g = cubic_lattice((2, 2, 2))
         np.testing.assert_array_equal(conductance(g, 2.0, name, value=3.0), np.full(12, 1.5))
@@ -193,17 +197,21 @@ def test_register_a_law_and_refuse_a_duplicate_name():
         with pytest.raises(ValueError, match="already registered"):
             register_conductance_law("continuum")(constant)
     finally:
-        _LAWS.pop(name, None)
+        unregister_conductance_law(name)
 
 
 def test_a_law_returning_negative_values_is_refused():
     name = "test-negative"
+
+    class Negative(ConductanceLaw):
+        def factor(self, graph, edges=None):
+            return -np.ones(len(self._edges(graph, edges)))
     try:
-        register_conductance_law(name)(lambda graph, rho: -np.ones(graph.n_edges))
+        register_conductance_law(name)(Negative)
         with pytest.raises(MaterialError, match="non-finite or negative"):
             conductance(cubic_lattice((2, 2, 2)), 1.0, name)
     finally:
-        _LAWS.pop(name, None)
+        unregister_conductance_law(name)
 
 
 @pytest.mark.parametrize("rho", [0.0, -1e-6, np.nan, np.inf, -np.inf])

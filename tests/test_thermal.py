@@ -17,9 +17,11 @@ import warnings
 import numpy as np
 import pytest
 
-from yade_electro import ContactGraph, MaterialError, ThermalError, conductance, solve_potential
+from yade_electro import ContactGraph, MaterialError, ThermalError, solve_potential
+from yade_electro.conductance import conductance
 from yade_electro.coupled import ElectroThermalModel
-from yade_electro.engine import ElectricalModel, History
+from yade_electro.electrical import ElectricalModel
+from yade_electro.history import History
 from yade_electro.errors import BoundaryConditionError
 from yade_electro.network import Electrode
 from yade_electro.surfaces import edge_transmission_surface, volume_fraction
@@ -434,7 +436,7 @@ def test_temperatures_follow_ids_when_the_graph_changes():
     # one bond broken: a new graph, the same elements
     g2 = g.with_edges(g.edges[1:])
     m.step(g2, 1e-12)
-    assert m.n_rebuilds == 2 and m.n_potential_solves == 2
+    assert m.n_rebuilds == 1 and m.n_potential_solves == 2          # same structure, one edge at g = 0
     np.testing.assert_allclose(m.temperature, T, rtol=1e-9)
     # reordered ids: temperatures go with the ids
     perm = np.arange(g.n_nodes)[::-1]
@@ -520,8 +522,10 @@ def test_coupled_model_keeps_its_history_on_thermal_error():
 def test_solver_setup_is_kept_while_dt_is_unchanged():
     hs = HeatSolver(*chain(30), 300.0, theta=1.0)
     assert hs.advance(1.0).info["setup"] is True
-    assert hs.advance(1.0).info["setup"] is False
-    assert hs.advance(0.5).info["setup"] is True
+    info = hs.advance(1.0).info
+    assert info["setup"] is False and info["update"] is False
+    info = hs.advance(0.5).info                     # another dt: the matrix values are refilled in place
+    assert info["setup"] is False and info["update"] is True and hs.solver.n_setups == 1
 
 
 def test_coupled_time_step_figures():

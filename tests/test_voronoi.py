@@ -2,30 +2,12 @@
 import numpy as np
 import pytest
 
-from yade_electro import ContactGraph, conductance
-from yade_electro.conductance import network_graph
-from yade_electro.engine import ElectricalModel
+from yade_electro import ContactGraph
+from yade_electro.conductance import conductance, make_law
+from yade_electro.electrical import ElectricalModel
+from yade_electro.geometry import Box
 from yade_electro.network import equivalent_resistance
 from yade_electro.voronoi import VoronoiFaces, voronoi_faces
-
-
-class Box:
-    """Axis-aligned box with an exact signed distance (negative inside) and its gradient."""
-
-    def __init__(self, lo, hi):
-        self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
-
-    def sdf(self, x):
-        x = np.atleast_2d(x)
-        q = np.maximum(self.lo - x, x - self.hi)
-        out = np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(axis=1), 0)
-        return out
-
-    def gradient(self, x):
-        x = np.atleast_2d(x)
-        h = 1e-9 * float(np.max(self.hi - self.lo))
-        g = np.stack([(self.sdf(x + h * e) - self.sdf(x - h * e)) / (2 * h) for e in np.eye(3)], axis=1)
-        return g / np.linalg.norm(g, axis=1)[:, None]
 
 
 def test_cubic_lattice_faces_are_the_cube_faces():
@@ -91,13 +73,14 @@ def test_cut_bonds_cut_the_current():
 
 def test_hops_widen_the_network_and_faces_are_reused():
     graph, box, L = _rod_graph(1)
-    cache = {}
-    n1 = network_graph(graph, "voronoi", container=box, cache=cache, hops=1)
-    faces = cache["faces"]
-    n3 = network_graph(graph, "voronoi", container=box, cache=cache, hops=3)
-    assert cache["faces"] is faces           # the tessellation is made once
-    assert n3.n_edges >= n1.n_edges
-    np.testing.assert_array_equal(n1.edges, np.unique(np.sort(graph.edges, axis=1), axis=0))
+    law1 = make_law("voronoi", container=box, hops=1)
+    n1 = law1.network(graph)
+    faces = law1.faces(graph)
+    law1.factor(graph, n1)
+    assert law1.faces(graph) is faces and law1.tessellations == 1       # the tessellation is made once
+    n3 = make_law("voronoi", container=box, hops=3).network(graph)
+    assert n3.shape[0] >= n1.shape[0]
+    np.testing.assert_array_equal(n1, np.unique(np.sort(graph.edges, axis=1), axis=0))
 
 
 def test_voronoi_needs_a_container():
@@ -116,8 +99,7 @@ def test_cells_at_a_re_entrant_corner_are_not_cut_away():
     """An L-shaped solid (a box minus a box): tangent planes of the concave corner must not
     cut solid away; every cell keeps a volume and the cells fill the solid."""
     from yade_electro.voronoi import voronoi_cell_volumes
-    from yade_electro.yade.packing import Box as ShapeBox
-    solid = ShapeBox((0, 0, 0), (2, 2, 1)) - ShapeBox((1, 1, -1), (3, 3, 2))
+    solid = Box((0, 0, 0), (2, 2, 1)) - Box((1, 1, -1), (3, 3, 2))
     rng = np.random.default_rng(5)
     pts = rng.uniform([0, 0, 0], [2, 2, 1], size=(3000, 3))
     pts = pts[np.asarray(solid.sdf(pts)) < -0.02][:600]
@@ -139,5 +121,5 @@ def test_coupled_model_takes_voronoi_cell_capacities_by_default():
                          law="voronoi", law_params=dict(container=box))
     m = ElectroThermalModel(el, density=2.0, specific_heat=3.0, conductivity=1.0, temperature=0.0)
     m.step(graph, 1e-3)
-    assert m.heat.capacity.sum() == pytest.approx(2.0 * 3.0 * (1 * 1 * L), rel=1e-9)
-    assert el._law_cache["faces"]._volumes is not None      # made from the law's tessellation
+    assert m.capacity.sum() == pytest.approx(2.0 * 3.0 * (1 * 1 * L), rel=1e-9)
+    assert el.law.tessellations == 1                          # the capacities came from the law's tessellation

@@ -1,80 +1,74 @@
-"""Edge conductance laws, in one registry.
+"""Conductance laws, in one registry. A law gives the *geometric factor* g_ij [m] of every edge;
+the material makes it a conductance.
 
-A law is a pure function ``law(graph, resistivity, **params) -> c`` that returns the
-electrical conductance c_ij [S] of every edge of a :class:`ContactGraph`. The same laws
-give thermal conductances when called with the thermal resistivity 1/lambda [m K / W]
-(the result is then in W/K).
+Structure and values are kept apart: g depends on the geometry only, so
 
-``resistivity`` is a positive scalar [ohm m] or one value per node; with per-node values an
-edge is two half-length rods in series: R_ij = (rho_i + rho_j) / 2 * l_ij / S_ij.
+* the electrical conductance is ``c = g / rho_edge`` [S] (:func:`conductance`),
+* the thermal conductance is ``G = lambda_edge g`` [W/K],
+
+with the per-edge material of :mod:`yade_electro.materials` (mean resistivity, harmonic mean
+conductivity: two half rods in series). A change of temperature (rho_e(T)) changes values only;
+a move of the elements changes g, never the structure.
+
+A law is an object made by :func:`make_law` (``make_law('voronoi', container=shape)``) with
+
+* ``network(graph) -> (m, 2)`` the node pairs that conduct (the bonds, or for 'voronoi' the
+  Voronoi neighbours the bonds support), and
+* ``factor(graph, edges) -> (m,)`` the geometric factor of those pairs [m].
+
+It keeps what it computed once (the tessellation of the 'voronoi' law). Unknown names raise
+and list the known ones.
 
 Laws
 ----
 continuum
-    Paper 000: c_ij = S_ij / (rho l_ij), S_ij = sqrt(S_i S_j), S_i = alpha(n_i) r_i^2 / f_i.
-    Parameters: ``threshold`` (eccentricity limit, 0.4) and ``factor`` (f for eccentric
+    Paper 000: g = S_ij / l_ij, S_ij = sqrt(S_i S_j), S_i = alpha(n_i) r_i^2 / f_i.
+    Parameters: ``threshold`` (eccentricity limit, 0.4) and ``factor`` (f of eccentric
     elements, 2).
-contact
-    Constriction conductance of two overlapping spheres (papers 002, 003): c = 2 a / rho,
-    a the radius of the contact circle of the lens.
 voronoi
     Faces of the Voronoi tessellation of the element centres, bounded by the solid's
-    ``container`` (required: an object with ``sdf`` and ``gradient``, e.g. a shape of
-    ``yade_electro.yade.packing``): c_ij = A_ij / (rho l_ij). Exact for uniform fields, no
-    constant to choose (see ``yade_electro.voronoi``). A face conducts while its two
-    elements are linked by a path of at most ``hops`` (default 3) intact bonds, so cracks
-    (broken bonds) cut the current; the faces are computed once on the first configuration.
+    ``container`` (a :class:`yade_electro.geometry.Shape`): g = A_ij / l_ij, exact for uniform
+    fields (see :mod:`yade_electro.voronoi`). A face conducts while its two elements are linked
+    by a path of at most ``hops`` (3) intact bonds. The tessellation is made on the first
+    configuration of an element set (or the ``reference`` one: ids, positions, radii) and kept
+    (small-strain view: the faces keep their areas, l_ij follows the elements).
+contact
+    Constriction of two overlapping spheres (papers 002, 003): g = 2 a, a the radius of the
+    contact circle of the lens.
 liggghts
-    The form LIGGGHTS' heat-conduction fix uses: c = 4 k1 k2 / (k1 + k2) sqrt(pi a^2),
-    k = 1/rho; for equal materials c = 2 sqrt(pi) a / rho.
+    LIGGGHTS' heat-conduction fix: 4 k1 k2 / (k1 + k2) sqrt(pi a^2) = k_edge 2 sqrt(pi) a, so
+    g = 2 sqrt(pi) a (k_edge the harmonic mean).
 """
 from __future__ import annotations
 
-from typing import Callable, Dict, Optional
+from typing import Callable, Dict
 
 import numpy as np
 
 from .errors import MaterialError
 from .graph import ContactGraph
+from .materials import edge_resistivity, positive_property
 from .surfaces import edge_transmission_surface
 
-__all__ = ["conductance", "conductance_laws", "network_graph", "register_conductance_law", "check_resistivity",
-           "contact_radius", "edge_resistivity"]
+__all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
+           "check_law_name", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
 
 _LAWS: Dict[str, Callable] = {}
-_EXPANDERS: Dict[str, Callable] = {}
 
 
-def register_conductance_law(name: str, expand: Optional[Callable] = None):
-    """Decorator that adds a law ``f(graph, resistivity, **params) -> (m,) array`` to the registry.
-
-    ``expand(graph, **params) -> graph``, optional, gives the network the law conducts on
-    when it is not the bond graph itself (the ``voronoi`` law adds the faces of non-bonded
-    Voronoi neighbours); see :func:`network_graph`.
-    """
-    def deco(fn):
+def register_conductance_law(name: str):
+    """Decorator adding a law class (or factory ``f(**params) -> law``) to the registry."""
+    def deco(factory):
         if name in _LAWS:
             raise ValueError(f"conductance law {name!r} is already registered")
-        _LAWS[name] = fn
-        if expand is not None:
-            _EXPANDERS[name] = expand
-        return fn
+        _LAWS[name] = factory
+        return factory
     return deco
 
 
-def network_graph(graph: ContactGraph, law: str = "continuum", **params) -> ContactGraph:
-    """The graph whose edges carry current under ``law``: the bond graph itself, or (for laws
-    with an expander, e.g. 'voronoi') a graph with the same nodes and more edges."""
-    _law(law)
-    fn = _EXPANDERS.get(law)
-    return graph if fn is None else fn(graph, **params)
-
-
-def _law(law):
-    try:
-        return _LAWS[law]
-    except KeyError:
-        raise KeyError(f"unknown conductance law {law!r}; known laws: {', '.join(conductance_laws())}") from None
+def unregister_conductance_law(name: str) -> None:
+    """Remove a law from the registry (a no-op for unknown names)."""
+    _LAWS.pop(name, None)
 
 
 def conductance_laws() -> tuple:
@@ -82,29 +76,160 @@ def conductance_laws() -> tuple:
     return tuple(sorted(_LAWS))
 
 
-def check_resistivity(resistivity, n_nodes: int, name: str = "resistivity") -> np.ndarray:
-    """Return ``resistivity`` as a float array (scalar or (n,)), or raise MaterialError if it is
-    not finite and strictly positive."""
-    rho = np.asarray(resistivity, dtype=float)
-    if rho.ndim not in (0, 1) or (rho.ndim == 1 and rho.shape[0] != n_nodes):
-        raise MaterialError(f"{name} must be a scalar or one value per element ({n_nodes}), "
-                            f"got shape {rho.shape}")
-    if not np.all(np.isfinite(rho)) or np.any(rho <= 0):
-        bad = rho if rho.ndim == 0 else rho[~(np.isfinite(rho) & (rho > 0))][:5]
-        raise MaterialError(f"{name} must be finite and > 0 (SI units, ohm m for electrical "
-                            f"resistivity); got {np.atleast_1d(bad).tolist()}")
-    return rho
+def check_law_name(law) -> None:
+    """Raise KeyError (listing the known laws) for an unknown law name."""
+    if isinstance(law, ConductanceLaw):
+        return
+    if law not in _LAWS:
+        raise KeyError(f"unknown conductance law {law!r}; known laws: {', '.join(conductance_laws())}")
 
 
-def edge_resistivity(graph: ContactGraph, rho: np.ndarray) -> np.ndarray:
-    """Resistivity of each edge: the scalar, or the mean of the two end nodes' values."""
-    if rho.ndim == 0:
-        return np.full(graph.n_edges, float(rho))
-    return 0.5 * (rho[graph.edges[:, 0]] + rho[graph.edges[:, 1]])
+def make_law(law="continuum", **params) -> "ConductanceLaw":
+    """A law object from its name and parameters (a law object is passed through)."""
+    if isinstance(law, ConductanceLaw):
+        if params:
+            raise ValueError("give parameters to make_law only with a law name")
+        return law
+    check_law_name(law)
+    return _LAWS[law](**params)
 
 
-def conductance(graph: ContactGraph, resistivity, law: str = "continuum", **params) -> np.ndarray:
-    """Conductance of every edge [S] (or [W/K] with a thermal resistivity) by the named law.
+def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
+    """Centre-to-centre distance of node pairs [m]; MaterialError for coincident centres."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    d = graph.pos[edges[:, 1]] - graph.pos[edges[:, 0]]
+    length = np.sqrt(np.einsum("ij,ij->i", d, d))
+    if np.any(length <= 0):
+        raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+    return length
+
+
+class ConductanceLaw:
+    """Base of the laws: the network is the bond graph, g comes from :meth:`factor`."""
+
+    name = "?"
+    #: True when the law needs the solid's container (a Shape)
+    needs_container = False
+
+    def network(self, graph: ContactGraph) -> np.ndarray:
+        """Node pairs (m, 2), i < j, that conduct on ``graph``."""
+        return graph.edges
+
+    def factor(self, graph: ContactGraph, edges=None) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _edges(self, graph, edges):
+        return graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+
+
+@register_conductance_law("continuum")
+class ContinuumLaw(ConductanceLaw):
+    """Paper 000 eq. 4-5: g = sqrt(S_i S_j) / l_ij on the bonds."""
+
+    name = "continuum"
+
+    def __init__(self, threshold: float = 0.4, factor: float = 2.0):
+        self.threshold, self.factor_ = float(threshold), float(factor)
+
+    def factor(self, graph, edges=None):
+        edges = self._edges(graph, edges)
+        if edges is not graph.edges and not np.array_equal(edges, graph.edges):
+            raise ValueError("the continuum law conducts through the bonds of the graph only")
+        s = edge_transmission_surface(graph, threshold=self.threshold, factor=self.factor_)
+        return s / edge_lengths(graph, edges)
+
+
+def contact_radius(graph: ContactGraph, edges=None) -> np.ndarray:
+    """Radius a [m] of the contact circle of each edge's two overlapping spheres (0 where
+    they do not overlap): a^2 = r1^2 - ((r1^2 - r2^2 + d^2) / (2 d))^2."""
+    edges = graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    r1 = graph.radius[edges[:, 0]]
+    r2 = graph.radius[edges[:, 1]]
+    d = edge_lengths(graph, edges)
+    x = (r1 ** 2 - r2 ** 2 + d ** 2) / (2.0 * d)
+    a2 = r1 ** 2 - x ** 2
+    a2 = np.where(d < r1 + r2, a2, 0.0)
+    return np.sqrt(np.clip(a2, 0.0, None))
+
+
+@register_conductance_law("contact")
+class ContactLaw(ConductanceLaw):
+    """Constriction of overlapping spheres (papers 002, 003): g = 2 a."""
+
+    name = "contact"
+
+    def factor(self, graph, edges=None):
+        return 2.0 * contact_radius(graph, self._edges(graph, edges))
+
+
+@register_conductance_law("liggghts")
+class LiggghtsLaw(ConductanceLaw):
+    """LIGGGHTS' form 4 k1 k2 / (k1 + k2) sqrt(pi a^2) = k_edge 2 sqrt(pi) a: g = 2 sqrt(pi) a."""
+
+    name = "liggghts"
+
+    def factor(self, graph, edges=None):
+        return 2.0 * np.sqrt(np.pi) * contact_radius(graph, self._edges(graph, edges))
+
+
+@register_conductance_law("voronoi")
+class VoronoiLaw(ConductanceLaw):
+    """g = A_ij / l_ij, A_ij the Voronoi face of i and j inside the container."""
+
+    name = "voronoi"
+    needs_container = True
+
+    def __init__(self, container=None, hops: int = 3, reference=None):
+        if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
+            raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
+                             "and gradient(x) (e.g. yade_electro.geometry.as_shape(predicate)); "
+                             f"got {container!r}")
+        if isinstance(hops, bool) or int(hops) != hops or hops < 1:
+            raise ValueError(f"hops must be an integer >= 1, got {hops!r}")
+        self.container, self.hops = container, int(hops)
+        self.reference = None if reference is None else tuple(np.asarray(a) for a in reference)
+        self._faces = None
+        self._key = None
+        self.tessellations = 0
+
+    def faces(self, graph: ContactGraph):
+        """The kept tessellation's faces, made once per element set: on ``reference`` (ids,
+        pos, radius) when it holds the same elements (a resumed run), else on the first graph
+        of the set."""
+        key = graph.ids.tobytes()
+        if self._key != key:
+            from .voronoi import VoronoiFaces
+            ref = self.reference
+            if ref is not None and ref[0].shape == graph.ids.shape and np.array_equal(ref[0], graph.ids):
+                base = ContactGraph(ref[1], ref[2], np.zeros((0, 2), dtype=np.int64), ref[0])
+            else:
+                base = graph
+            self._faces = VoronoiFaces.of(base, self.container)
+            self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius))
+            self._key = key
+            self.tessellations += 1
+        return self._faces
+
+    def network(self, graph):
+        return self.faces(graph).supported_pairs(graph.edges, self.hops)
+
+    def factor(self, graph, edges=None):
+        edges = self._edges(graph, edges)
+        return self.faces(graph).area_of(edges) / edge_lengths(graph, edges)
+
+    def cell_volumes(self, graph) -> np.ndarray:
+        """Bounded Voronoi cell volumes [m^3] from the kept tessellation."""
+        return self.faces(graph).cell_volumes()
+
+
+def geometric_factor(graph: ContactGraph, law="continuum", **params) -> np.ndarray:
+    """g [m] of every edge of ``graph`` by the named law (one-shot; see :func:`make_law`)."""
+    return make_law(law, **params).factor(graph, graph.edges)
+
+
+def conductance(graph: ContactGraph, resistivity, law="continuum", **params) -> np.ndarray:
+    """Conductance of every edge of ``graph`` [S] (or [W/K] with a thermal resistivity 1/lambda):
+    ``g / rho_edge``.
 
     Raises
     ------
@@ -113,78 +238,74 @@ def conductance(graph: ContactGraph, resistivity, law: str = "continuum", **para
     MaterialError
         Resistivity not finite and positive.
     """
-    fn = _law(law)
-    rho = check_resistivity(resistivity, graph.n_nodes)
-    c = fn(graph, rho, **params)
+    law = make_law(law, **params)
+    rho = positive_property("resistivity", resistivity, graph.n_nodes, " (ohm m for electrical resistivity)")
+    g = law.factor(graph, graph.edges)
+    c = g / edge_resistivity(rho, graph.edges)
     if not np.all(np.isfinite(c)) or np.any(c < 0):
-        raise MaterialError(f"conductance law {law!r} produced non-finite or negative values")
+        raise MaterialError(f"conductance law {law.name!r} produced non-finite or negative values")
     return c
 
 
-@register_conductance_law("continuum")
-def continuum_conductance(graph: ContactGraph, rho, threshold: float = 0.4, factor: float = 2.0):
-    """Paper 000 eq. 4-5: c_ij = sqrt(S_i S_j) / (rho l_ij)."""
-    s = edge_transmission_surface(graph, threshold=threshold, factor=factor)
-    length = graph.length
-    if np.any(length <= 0):
-        raise MaterialError("two bonded elements have coincident centres (l_ij = 0)")
-    return s / (edge_resistivity(graph, rho) * length)
+class FactorNetwork:
+    """A law's network on a changing graph, kept with its geometric factors.
+
+    ``update(graph)`` compares the graph with the previous one and returns what changed:
+
+    * ``None``: nothing (same object, or same elements, bonds and positions);
+    * ``'geometry'``: the elements moved: new factors g on the same edges;
+    * ``'topology'``: the bonds changed and the law's new network is a subset of the kept
+      edges (bonds broke): the lost edges get g = 0, the edge list stays;
+    * ``'structure'``: another element set, or new edges: a new edge list.
+
+    Attributes
+    ----------
+    edges : (m, 2) the kept edges (node pairs of ``graph``)
+    factor : (m,) g on ``edges`` [m] (0 on edges the law no longer conducts through)
+    graph : the graph of the last update
+    """
+
+    def __init__(self, law: ConductanceLaw):
+        self.law = law
+        self.graph: ContactGraph = None
+        self.edges = None
+        self.factor = None
+        self._net = None
+        self._slots = None
+        self._pos = None
+
+    def update(self, graph: ContactGraph):
+        from .network import edge_slots
+        old = self.graph
+        if old is not None and graph is old:
+            return None
+        self.graph = graph
+        if old is None or graph.n_nodes != old.n_nodes or not np.array_equal(graph.ids, old.ids):
+            self._rebuild(graph)
+            return "structure"
+        same_bonds = graph.edges is old.edges or np.array_equal(graph.edges, old.edges)
+        moved = not (graph.pos is self._pos or np.array_equal(graph.pos, self._pos))
+        if same_bonds and not moved:
+            return None
+        kind = "geometry"
+        if not same_bonds:
+            net = self.law.network(graph)
+            slots = edge_slots(self.edges, net, graph.n_nodes)
+            if slots is None:
+                self._rebuild(graph)
+                return "structure"
+            self._net, self._slots = net, slots
+            kind = "topology"
+        g = np.zeros(self.edges.shape[0])
+        g[self._slots] = self.law.factor(graph, self._net)
+        self.factor, self._pos = g, graph.pos
+        return kind
+
+    def _rebuild(self, graph):
+        net = self.law.network(graph)
+        self.edges, self._net, self._slots = net, net, np.arange(net.shape[0])
+        self.factor = self.law.factor(graph, net)
+        self._pos = graph.pos
 
 
-def contact_radius(graph: ContactGraph) -> np.ndarray:
-    """Radius a [m] of the contact circle of each edge's two overlapping spheres (0 where
-    they do not overlap): a^2 = r1^2 - ((r1^2 - r2^2 + d^2) / (2 d))^2."""
-    r1 = graph.radius[graph.edges[:, 0]]
-    r2 = graph.radius[graph.edges[:, 1]]
-    d = graph.length
-    x = (r1 ** 2 - r2 ** 2 + d ** 2) / (2.0 * d)
-    a2 = r1 ** 2 - x ** 2
-    a2 = np.where(d < r1 + r2, a2, 0.0)
-    return np.sqrt(np.clip(a2, 0.0, None))
-
-
-@register_conductance_law("contact")
-def contact_conductance(graph: ContactGraph, rho):
-    """Constriction conductance 2 a / rho of overlapping spheres (papers 002, 003)."""
-    return 2.0 * contact_radius(graph) / edge_resistivity(graph, rho)
-
-
-@register_conductance_law("liggghts")
-def liggghts_conductance(graph: ContactGraph, rho):
-    """LIGGGHTS' form 4 k1 k2 / (k1 + k2) sqrt(pi a^2), k = 1/rho of each node."""
-    if rho.ndim == 0:
-        k1 = k2 = 1.0 / float(rho)
-    else:
-        k1, k2 = 1.0 / rho[graph.edges[:, 0]], 1.0 / rho[graph.edges[:, 1]]
-    return 4.0 * k1 * k2 / (k1 + k2) * np.sqrt(np.pi) * contact_radius(graph)
-
-
-def _voronoi_faces_for(graph: ContactGraph, container, cache):
-    from .voronoi import VoronoiFaces
-    if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
-        raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
-                         "and gradient(x) (e.g. yade_electro.yade.packing.as_shape(predicate)); "
-                         f"got {container!r}")
-    # the tessellation is made once, on the first (reference) configuration, and kept while
-    # the same elements are there: moving elements change l_ij, not the face areas
-    # (small-strain view); a new element set, or ElectricalModel.reset(), makes it anew
-    key = ("voronoi", graph.n_nodes, graph.ids.tobytes(), id(container))
-    if cache is not None and cache.get("key") == key:
-        return cache["faces"]
-    faces = VoronoiFaces.of(graph, container)
-    if cache is not None:
-        cache.clear()
-        cache.update(key=key, faces=faces, container=container)
-    return faces
-
-
-def _voronoi_expand(graph: ContactGraph, container=None, cache=None, hops: int = 3):
-    faces = _voronoi_faces_for(graph, container, cache)
-    return graph.with_edges(faces.supported_pairs(graph.edges, hops), revision=graph.revision)
-
-
-@register_conductance_law("voronoi", expand=_voronoi_expand)
-def voronoi_conductance(graph: ContactGraph, rho, container=None, cache=None, hops: int = 3):
-    """c_ij = A_ij / (rho l_ij), A_ij the Voronoi face of i and j inside the container."""
-    faces = _voronoi_faces_for(graph, container, cache)
-    return faces.area_of(graph.edges) / (edge_resistivity(graph, rho) * graph.length)
+__all__ += ["FactorNetwork"]

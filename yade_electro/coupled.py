@@ -1,23 +1,30 @@
-"""Electro-thermal coupling: potential solve -> Joule sources -> heat step, one call per period.
+"""Electro-thermal coupling: potential -> Joule sources -> heat step, one call per period.
 
-:class:`ElectroThermalModel` wraps an :class:`~yade_electro.engine.ElectricalModel` and a
-:class:`~yade_electro.thermal.HeatSolver` and keeps their state between calls of
-``step(graph, dt)``:
+:class:`ElectroThermalModel` joins an :class:`~yade_electro.electrical.ElectricalModel` (or no
+electrical model: heat conduction only) and a :class:`~yade_electro.thermal.HeatSolver` and
+keeps both across calls of ``step(graph, dt)``. One geometric factor g per edge serves the
+electrical conductance (g / rho_e), the thermal conductance (lambda g), the Joule heat and the
+history. What a call costs depends on what changed:
 
-* the potential is solved again only when something it depends on changed: the graph
-  (object or revision), the resistivity (with ``beta != 0`` it follows the temperatures,
-  ``rho_e(T) = rho_0 (1 + beta (T - T_0))`` per node), or the electrode values. With a
-  constant resistivity, one potential solve serves any number of thermal steps;
-* the heat solver (capacities, conductances, factorisation) is rebuilt only when the graph
-  changes; temperatures are carried over by node id (new elements start at ``T_0``).
-  Capacities depend on the bonds through the volume fractions, so ``heat_content`` can jump
-  when bonds break.
+* nothing: the potential of the previous call is reused (constant rho_e), the heat step is
+  one warm-started solve with the kept matrix;
+* rho_e(T) (``beta != 0``): conductances updated in place, potential re-solved warm with the
+  kept solver setup (re-solved only when some element's resistivity moved by more than
+  ``resistivity_tol``, relative, default 0: whenever it changed);
+* moved elements: new g, electrical and thermal values updated in place;
+* broken bonds: the lost edges get g = 0 (same structure); the capacities follow the new
+  bond counts (paper model) or stay (Voronoi cells);
+* another element set: new structures; temperatures carried over by element id, new
+  elements start at ``temperature``; time and energy ledger continue.
 
-Coupling in time: by default the sources of a step are computed with the resistivity at the
-start of the step (lagged, first order). ``coupling_iterations = k > 0`` re-solves the
-potential up to k times with the resistivity at the mid-step temperature ``(T^n +
-T^{n+1})/2`` (fixed-point iterations, second order in dt), stopping when the sources change
-by less than ``coupling_tol`` (relative).
+One owner each: the thermal clock and the energy ledger are the heat solver's (``time``,
+``energy``), the electrode values the electrical model's (``set_electrode``).
+
+Coupling in time: the sources of a step are computed with the resistivity at the start of
+the step (lagged, first order); ``coupling_iterations = k > 0`` re-solves the potential up to
+k times with the resistivity at the mid-step temperature ``(T^n + T^{n+1})/2`` (fixed-point
+iterations, second order in dt), stopping when the sources change by less than
+``coupling_tol`` (relative).
 
 Units: SI; temperatures in K (or degC if T_0 and every temperature are in degC).
 """
@@ -28,11 +35,15 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
-from .engine import ElectricalModel, History
+from .conductance import FactorNetwork, make_law
+from .electrical import ElectricalModel
 from .errors import MaterialError
 from .graph import ContactGraph
+from .history import History
+from .materials import Material, edge_conductivity, real_number
+from .selection import Membership
 from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, diffusion_time_step, heat_capacity,
-                      joule_sources, thermal_conductance)
+                      joule_sources, theta_of)
 
 __all__ = ["ElectroThermalModel"]
 
@@ -44,9 +55,10 @@ class ElectroThermalModel:
 
     Parameters
     ----------
-    electrical : ElectricalModel
+    electrical : ElectricalModel or None
         Electrodes (voltage- or current-driven), conductance law, solver; its resistivity is
-        rho_0, the value at ``reference_temperature``.
+        rho_0, the value at ``reference_temperature``. None: heat conduction only (then give
+        ``law``/``law_params``).
     density : float or (n,) [kg/m^3]
     specific_heat : float or (n,) [J/(kg K)]
     conductivity : float or (n,) thermal conductivity lambda [W/(m K)]
@@ -59,154 +71,188 @@ class ElectroThermalModel:
     eta : float in [0, 1]
         Share of the electrical power released as heat (paper 000 eq. 11).
     theta : float or name
-        Heat integrator: 'explicit' (sub-cycled to the stable step), 'crank-nicolson',
-        'backward-euler' (default) or a number in [0, 1].
+        'explicit' (sub-cycled to the stable step), 'crank-nicolson', 'backward-euler'
+        (default) or a number in [0, 1].
     subcycle, safety, max_substeps, thermal_solver :
         Passed to :class:`HeatSolver` (``thermal_solver`` is its ``solver``).
     fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
-        Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids).
+        Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
+        on the first graph and then kept by element id.
     area : callable(graph) -> (n,) exposed areas [m^2], optional
         Default area of convection/flux conditions (else ``thermal.exposed_area``).
     volume_fraction, cell_volume : optional, see :func:`~yade_electro.thermal.heat_capacity`
-        Scalars or callables ``f(graph) -> (n,)`` (per-node arrays only fit a fixed graph).
-        Default: paper 000's fv(n) capacities, except with the 'voronoi' law, where the
-        bounded Voronoi cell volumes are used (``voronoi.cell_volume_of(container)``).
-    coupling_iterations, coupling_tol : see the module notes.
-    resistivity_tol : float
-        With beta != 0, re-solve the potential only when some node's resistivity moved by
-        more than this (relative) since the last solve (default 0: whenever it changed).
+        Scalars or callables ``f(graph) -> (n,)``. Default: paper 000's fv(n) capacities,
+        except with the 'voronoi' law, where its bounded Voronoi cell volumes are used.
+    coupling_iterations, coupling_tol, resistivity_tol : see the module notes.
+    law, law_params : conductance law of the heat-only model (``electrical=None``).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
     """
 
-    def __init__(self, electrical: ElectricalModel, density, specific_heat, conductivity, temperature: float,
-                 *, reference_temperature: Optional[float] = None, beta: float = 0.0, eta: float = 1.0,
-                 theta="backward-euler", subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000,
-                 thermal_solver="direct", fixed: Sequence[FixedTemperature] = (), flux: Sequence[HeatFlux] = (),
-                 convection: Sequence[Convection] = (), area=None, volume_fraction=None, cell_volume=None,
-                 coupling_iterations: int = 0, coupling_tol: float = 1e-10, resistivity_tol: float = 0.0,
-                 history=None):
-        if not isinstance(electrical, ElectricalModel):
-            raise TypeError("electrical must be an ElectricalModel (yade_electro.engine)")
+    def __init__(self, electrical: Optional[ElectricalModel], density, specific_heat, conductivity,
+                 temperature: float, *, reference_temperature: Optional[float] = None, beta: float = 0.0,
+                 eta: float = 1.0, theta="backward-euler", subcycle: bool = True, safety: float = 0.9,
+                 max_substeps: int = 100000, thermal_solver="cg", fixed: Sequence[FixedTemperature] = (),
+                 flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), area=None,
+                 volume_fraction=None, cell_volume=None, coupling_iterations: int = 0, coupling_tol: float = 1e-10,
+                 resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None):
+        if electrical is not None and not isinstance(electrical, ElectricalModel):
+            raise TypeError("electrical must be an ElectricalModel (yade_electro.electrical) or None")
         self.electrical = electrical
-        self.rho0 = electrical.resistivity
-        self.density, self.specific_heat, self.conductivity = density, specific_heat, conductivity
-        if not np.isfinite(temperature):
-            raise ValueError(f"temperature must be finite, got {temperature}")
-        self.initial_temperature = float(temperature)
-        self.T0 = float(temperature if reference_temperature is None else reference_temperature)
-        if not np.isfinite(beta):
-            raise MaterialError(f"beta must be finite (1/K), got {beta}")
-        self.beta = float(beta)
-        if not (0.0 <= eta <= 1.0):
+        self.initial_temperature = real_number("temperature (K)", temperature)
+        T0 = self.initial_temperature if reference_temperature is None else reference_temperature
+        rho0 = electrical.material.resistivity if electrical is not None else None
+        self.material = Material(resistivity=rho0, beta=beta, reference_temperature=T0, density=density,
+                                 specific_heat=specific_heat, conductivity=conductivity)
+        if beta != 0.0 and electrical is None:
+            raise MaterialError("beta (rho_e(T)) needs an electrical model")
+        self.T0 = float(self.material.reference_temperature)
+        self.beta = self.material.beta
+        self.eta = real_number("eta (share of the electrical power released as heat)", eta)
+        if not (0.0 <= self.eta <= 1.0):
             raise ValueError(f"eta must be in [0, 1], got {eta}")
-        self.eta = float(eta)
+        theta_of(theta)
         self.heat_options = dict(theta=theta, subcycle=subcycle, safety=safety, max_substeps=max_substeps,
                                  solver=thermal_solver)
         self.fixed, self.flux, self.convection = list(fixed), list(flux), list(convection)
-        if (cell_volume is None and volume_fraction is None and electrical.law == "voronoi"
-                and electrical.law_params.get("container") is not None):
-            # the capacities that go with Voronoi conductances: the cells fill the solid,
-            # from the tessellation the electrical law already made for this element set
-            cell_volume = self._voronoi_cells
+        for group, cls in ((self.fixed, FixedTemperature), (self.flux, HeatFlux), (self.convection, Convection)):
+            for bc in group:
+                if not isinstance(bc, cls):
+                    raise TypeError(f"expected {cls.__name__} objects, got {bc!r}")
+        names = [b.name for b in self.fixed + self.flux + self.convection]
+        if len(set(names)) != len(names):
+            from .errors import BoundaryConditionError
+            raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
+        self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition") for b in self.fixed + self.flux + self.convection}
+        self.network = electrical.network if electrical is not None else FactorNetwork(
+            make_law(law, **dict(law_params or {})))
+        if cell_volume is None and volume_fraction is None and hasattr(self.network.law, "cell_volumes"):
+            # the capacities that go with Voronoi conductances: the cells fill the solid
+            cell_volume = self.network.law.cell_volumes
         self.area, self.volume_fraction, self.cell_volume = area, volume_fraction, cell_volume
-        if int(coupling_iterations) < 0:
-            raise ValueError("coupling_iterations must be >= 0")
+        if int(coupling_iterations) != coupling_iterations or coupling_iterations < 0:
+            raise ValueError("coupling_iterations must be an integer >= 0")
         self.coupling_iterations, self.coupling_tol = int(coupling_iterations), float(coupling_tol)
-        self.resistivity_tol = float(resistivity_tol)
+        self.resistivity_tol = real_number("resistivity_tol", resistivity_tol)
         self.history = History(history) if isinstance(history, str) else history
 
         self.heat: Optional[HeatSolver] = None
-        self.graph: Optional[ContactGraph] = None
-        self._graph_key = None
-        self.time = 0.0
-        self.joule_energy = 0.0
         self.n_potential_solves = 0
         self.n_rebuilds = 0
-        self._sol_key = None
         self._rho_solved = None     # per-node resistivity of the last potential solve
-        self._rho_version = 0
-        self._values: dict = {}
+        self._sol_id = None
         self.solution = None
         self.sources = None
+        self._time0, self._energy0 = 0.0, None
 
-    def _voronoi_cells(self, graph: ContactGraph) -> np.ndarray:
-        """Bounded Voronoi cell volumes of ``graph``'s elements, from the electrical law's
-        cached tessellation (prepared for this graph just before)."""
-        faces = self.electrical._law_cache.get("faces")
-        if faces is None or faces.n != graph.n_nodes:
-            from .voronoi import voronoi_cell_volumes
-            return voronoi_cell_volumes(graph.pos, graph.radius, self.electrical.law_params["container"])
-        return faces.cell_volumes()
+    # -- one owner: time and energy are the heat solver's ------------------------------------
+    @property
+    def time(self) -> float:
+        """Thermal clock [s]."""
+        return self.heat.time if self.heat is not None else self._time0
+
+    @property
+    def joule_energy(self) -> float:
+        """Joule heat released since the start [J] (on free and on fixed-temperature nodes)."""
+        if self.heat is None:
+            return 0.0 if self._energy0 is None else self._energy0.get("source", 0.0) + self._energy0.get("absorbed", 0.0)
+        return self.heat.energy["source"] + self.heat.energy["absorbed"]
+
+    def restore(self, time: float, energy: Optional[dict] = None):
+        """Continue a saved run: thermal clock [s] and energy ledger [J] (before the first step)."""
+        if self.heat is not None:
+            self.heat.time = float(time)
+            if energy:
+                self.heat.energy.update({k: float(v) for k, v in energy.items() if k in self.heat.energy})
+        else:
+            self._time0, self._energy0 = float(time), dict(energy or {})
 
     # -- structure ---------------------------------------------------------------------------
-    @staticmethod
-    def _key(graph):
-        return (id(graph), graph.revision, graph.n_nodes, graph.n_edges)
+    def _capacities(self, graph):
+        vf = self.volume_fraction(graph) if callable(self.volume_fraction) else self.volume_fraction
+        cv = self.cell_volume(graph) if callable(self.cell_volume) else self.cell_volume
+        return heat_capacity(graph, self.material.density, self.material.specific_heat, volume_fraction=vf,
+                             cell_volume=cv)
 
-    def _prepare(self, graph: ContactGraph):
-        key = self._key(graph)
-        if key == self._graph_key and self.heat is not None:
+    def _thermal_conductance(self, graph):
+        lam = self.material.conductivity
+        return edge_conductivity(lam, self.network.edges) * self.network.factor
+
+    def prepare(self, graph: ContactGraph):
+        """Bring both models to ``graph`` (see the module doc)."""
+        if self.electrical is not None:
+            kind = self.electrical.update(graph)
+        else:
+            kind = self.network.update(graph)
+        if self.heat is None or graph.n_nodes != self.heat.n or kind == "structure" and not np.array_equal(
+                graph.ids, self._ids):
+            self._new_heat_solver(graph)
             return
+        if kind == "structure":
+            self.heat.update_edges(self.network.edges, self._thermal_conductance(graph), self._capacities(graph))
+            self.n_rebuilds += 1
+        elif kind == "topology":
+            self.heat.update_edges(self.network.edges, self._thermal_conductance(graph),
+                                   None if self.cell_volume is not None else self._capacities(graph))
+        elif kind == "geometry":
+            self.heat.update_values(self._thermal_conductance(graph))
+
+    def _new_heat_solver(self, graph):
         T = np.full(graph.n_nodes, self.initial_temperature)
+        time, energy = self._time0, self._energy0
         if self.heat is not None:               # carry the temperatures over by id
-            old_ids, old_T = self.graph.ids, self.heat.temperature
+            old_ids, old_T = self._ids, self.heat.temperature
             order = np.argsort(old_ids)
             pos = np.clip(np.searchsorted(old_ids[order], graph.ids), 0, old_ids.size - 1)
             found = old_ids[order][pos] == graph.ids
             T[found] = old_T[order][pos[found]]
-        self._set_resistivity(T, force=True)
-        el = self.electrical
-        el.prepare(graph)
-        net = el.graph
-        params = dict(el.law_params)
-        cache = getattr(el, "_law_cache", None)
-        if el.law == "voronoi" and cache is not None:
-            params["cache"] = cache
-        G = thermal_conductance(net, self.conductivity, el.law, **params)
-        vf = self.volume_fraction(graph) if callable(self.volume_fraction) else self.volume_fraction
-        cv = self.cell_volume(graph) if callable(self.cell_volume) else self.cell_volume
-        C = heat_capacity(graph, self.density, self.specific_heat, volume_fraction=vf, cell_volume=cv)
+            time, energy = self.heat.time, dict(self.heat.energy)
+        elif self._T_restore is not None:
+            T = self._T_restore(graph)
+        nodes_of = {name: m.nodes(graph) for name, m in self.bc_memberships.items()}
         area = self.area(graph) if callable(self.area) else self.area
-        self.heat = HeatSolver(C, net.edges, G, T, fixed=self.fixed, flux=self.flux, convection=self.convection,
-                               time=self.time, graph=graph, area=area, **self.heat_options)
-        self.graph, self._graph_key = graph, key
-        self._sol_key = None
+        self.heat = HeatSolver(self._capacities(graph), self.network.edges, self._thermal_conductance(graph), T,
+                               fixed=self.fixed, flux=self.flux, convection=self.convection, time=time,
+                               energy=energy, graph=graph, area=area, nodes_of=nodes_of, coords=graph.pos,
+                               **self.heat_options)
+        self._ids = graph.ids.copy()
+        self._rho_solved = None
         self.n_rebuilds += 1
         log.debug("electro-thermal model rebuilt on a graph of %d nodes, %d edges (dt_crit %.3g s)",
-                  graph.n_nodes, net.n_edges, self.heat.critical_time_step)
+                  graph.n_nodes, self.network.edges.shape[0], self.heat.critical_time_step)
 
-    def _rho_of(self, T):
-        return np.asarray(self.rho0, dtype=float) * (1.0 + self.beta * (np.asarray(T) - self.T0))
+    _T_restore = None
 
-    def _set_resistivity(self, T, force=False):
-        """Give the electrical model rho_e(T); True if it changed (a new solve is needed)."""
-        if self.beta == 0.0:
+    def restore_temperatures(self, fn):
+        """Temperatures of the first graph from ``fn(graph) -> (n,)`` (a resumed run)."""
+        self._T_restore = fn
+
+    # -- potential ---------------------------------------------------------------------------
+    def _set_resistivity(self, T, force=False) -> bool:
+        """Give the electrical model rho_e(T); True if it changed."""
+        if self.beta == 0.0 or self.electrical is None:
             return False
-        rho = self._rho_of(T)
-        if not np.all(rho > 0):
-            bad = np.flatnonzero(~(rho > 0))
-            raise MaterialError(f"rho_e(T) = rho_0 (1 + beta (T - T_0)) is <= 0 at {bad.size} node(s) "
-                                f"(e.g. node {bad[0]}, T = {np.atleast_1d(T)[bad[0]]:.6g}); beta={self.beta:g} "
-                                "does not fit this temperature range")
+        rho = self.material.resistivity_at(T)
         if not force and self._rho_solved is not None:
             change = np.max(np.abs(rho / self._rho_solved - 1.0))
             if change <= self.resistivity_tol and (self.resistivity_tol > 0 or change == 0):
                 return False
         self.electrical.set_resistivity(rho)
         self._rho_solved = rho
-        self._rho_version += 1
         return True
 
-    def _solve_potential(self, graph):
-        key = (self._graph_key, self._rho_version, tuple(sorted(self._values.items())))
-        if key != self._sol_key or self.solution is None:
-            self.solution = self.electrical.solve(graph, self._values or None)
-            self._sol_key = key
+    def _solve_potential(self):
+        n = self.heat.n
+        if self.electrical is None:
+            self.sources = np.zeros(n)
+            return self.sources
+        el = self.electrical
+        sol = el.solve()
+        if sol is not self._sol_id:
+            self.solution = sol
+            self._sol_id = sol
             self.n_potential_solves += 1
-            el = self.electrical
-            self.sources = joule_sources(el.graph.edges, self.solution.branch_current, el.conductance,
-                                         el.graph.n_nodes, self.eta)
+            self.sources = joule_sources(el.network_edges, sol.branch_current, el.conductance, n, self.eta)
         return self.sources
 
     # -- stepping ----------------------------------------------------------------------------
@@ -215,29 +261,37 @@ class ElectroThermalModel:
         currents [A] (kept for later steps). Returns the history row (and appends it to
         ``history``). A ThermalError leaves temperatures, time and energies as they were."""
         if values:
-            self._values.update({k: float(v) for k, v in values.items()})
-        self._prepare(graph)
+            if self.electrical is None:
+                raise ValueError("a heat-only model has no electrode values")
+            for k, v in values.items():
+                self.electrical.set_electrode(k, v)
+        self.prepare(graph)
         heat = self.heat
         self._set_resistivity(heat.temperature)
-        src = self._solve_potential(graph)
+        src = self._solve_potential()
         if self.beta != 0.0 and self.coupling_iterations > 0:
             T_old = heat.temperature
             for _ in range(self.coupling_iterations):
                 T_new, _ = heat.trial(dt, src)
                 self._set_resistivity(0.5 * (T_old + T_new))
-                new = self._solve_potential(graph)
+                new = self._solve_potential()
                 change = np.max(np.abs(new - src)) / max(np.max(np.abs(new)), 1e-300)
                 src = new
                 if change <= self.coupling_tol:
                     break
         step = heat.advance(dt, src)
-        self.time = heat.time
-        power = float(np.sum(src))
-        self.joule_energy += power * dt
-        row = self.summary(step, power)
+        row = self.summary(step, float(np.sum(src)))
         if self.history is not None:
             self.history.append(row)
         return row
+
+    def refresh(self, graph: ContactGraph) -> dict:
+        """Bring the models to ``graph`` and solve the potential without a heat step (an
+        engine's first call); returns the history row of that state."""
+        self.prepare(graph)
+        self._set_resistivity(self.heat.temperature)
+        self._solve_potential()
+        return self.summary()
 
     # -- figures ----------------------------------------------------------------------------
     @property
@@ -247,14 +301,22 @@ class ElectroThermalModel:
             raise RuntimeError("no step yet")
         return self.heat.temperature
 
+    @property
+    def capacity(self) -> np.ndarray:
+        """Heat capacities C_i of the current graph's elements [J/K]."""
+        if self.heat is None:
+            raise RuntimeError("no step yet")
+        return self.heat.capacity
+
     def time_steps(self) -> dict:
         """Thermal step figures of the current graph [s]: ``critical`` = min C_i / sum_j G_ij
         (the bound the explicit integrator uses), ``allowed`` = the (sub-)step it takes, and
         ``paper`` = l_min^2 / (2 alpha) (paper 000 eq. 14, for comparison)."""
         if self.heat is None:
             raise RuntimeError("no step yet")
+        m = self.material
         return {"critical": self.heat.critical_time_step, "allowed": self.heat.allowed_time_step(),
-                "paper": diffusion_time_step(self.graph, self.conductivity, self.density, self.specific_heat)}
+                "paper": diffusion_time_step(self.network.graph, m.conductivity, m.density, m.specific_heat)}
 
     def heat_content(self) -> float:
         """``sum_i C_i (T_i - T_0)`` [J]."""
@@ -269,18 +331,21 @@ class ElectroThermalModel:
         then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves.
         Balance: heat_content change = joule_energy - absorbed_heat + boundary_heat +
         convection_heat + flux_heat."""
-        sol, el, heat = self.solution, self.electrical, self.heat
-        names = list(sol.electrode_current)
-        a, b = el.measure if el.measure else (names[0], None)
+        heat = self.heat
+        row = {"time": self.time, "dt": step.dt if step is not None else 0.0}
+        if self.electrical is not None:
+            sol, el = self.solution, self.electrical
+            names = list(sol.electrode_current)
+            a, b = el.measure if el.measure else (names[0], None)
+            row.update({
+                "current": sol.electrode_current[a],
+                "voltage": sol.electrode_potential[a] - (sol.electrode_potential[b] if b else 0.0),
+                "R_eq": sol.equivalent_resistance(a, b) if b else float("nan"),
+                "joule_power": float(np.sum(self.sources)) if power is None else power,
+                "joule_energy": self.joule_energy,
+            })
         T, C = heat.temperature, heat.capacity
-        return {
-            "time": self.time,
-            "dt": step.dt if step is not None else 0.0,
-            "current": sol.electrode_current[a],
-            "voltage": sol.electrode_potential[a] - (sol.electrode_potential[b] if b else 0.0),
-            "R_eq": sol.equivalent_resistance(a, b) if b else float("nan"),
-            "joule_power": float(np.sum(self.sources)) if power is None else power,
-            "joule_energy": self.joule_energy,
+        row.update({
             "heat_content": float(np.sum(C * (T - self.T0))),
             "absorbed_heat": heat.energy["absorbed"],
             "boundary_heat": heat.energy["boundary"],
@@ -291,4 +356,5 @@ class ElectroThermalModel:
             "T_min": float(np.min(T)),
             "n_substeps": step.n_substeps if step is not None else 0,
             "n_potential_solves": self.n_potential_solves,
-        }
+        })
+        return row

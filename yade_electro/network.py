@@ -1,27 +1,47 @@
-"""Kirchhoff assembly, boundary conditions, solvers, currents and equivalent resistance.
+"""Kirchhoff networks with electrodes: structure kept, conductances updated in place, currents and
+an equivalent resistance that is a property of the network, not of the excitation.
 
-The network: nodes with potentials u [V], edges with conductances c [S]. With the
-incidence matrix A (row k: -1 at ``edges[k, 0]``, +1 at ``edges[k, 1]``) the nodal
-matrix is K = A^T C A (a weighted graph Laplacian) and Kirchhoff's current law reads
-K u = f, f the currents injected into the nodes [A].
+The network: nodes with potentials u [V], edges with conductances c [S]. With the incidence
+matrix A (row k: -1 at ``edges[k, 0]``, +1 at ``edges[k, 1]``) the nodal matrix is
+K = A^T C A (a weighted graph Laplacian) and Kirchhoff's current law reads K u = f, f the
+currents injected into the nodes [A].
 
-Boundary conditions are *electrodes*: sets of nodes tied together by a perfect conductor
-(one potential for all of them) that are either held at a fixed potential or fed with an
-imposed total current. Each electrode becomes one super-node of the reduced system; nodes
-that belong to no electrode may also receive injected currents.
+Electrodes are node sets tied by a perfect conductor (one potential for all of them), either
+held at a fixed potential or fed an imposed total current. They are the Dirichlet groups of a
+:class:`~yade_electro.condensation.ReducedSystem`; the unknowns are the other nodes.
+
+How a solve works (:class:`ConductionProblem`)
+----------------------------------------------
+For every electrode e the *characteristic potential* phi_e (1 V on e, 0 V on every other
+electrode) is solved once per set of conductances: K_uu phi_e = -K_ud 1_e. In a connected
+part with p electrodes the phi sum to 1, so p - 1 solves suffice (one for the usual two
+electrodes). They give the electrodes' conductance matrix (Dirichlet-to-Neumann map)
+
+    S = K_dd + K_du Phi,        I = S V (+ j, the part of node injections)
+
+with I the currents fed into the network at the electrodes. Any electrode values then cost no
+solve at all: imposed-current electrodes get their potentials from a small dense system,
+u = Phi V, and
+
+* ``R_eq(a, b)`` is computed from S alone: the two-terminal resistance between a and b with
+  the other electrodes left open (floating), exact whatever potentials or currents are
+  applied (also at 1 V / 1 V, where the applied current is 0);
+* changing an electrode value never re-solves; a change of conductances re-solves warm
+  (the previous phi as start) with the kept solver setup.
 
 Sign conventions
 ----------------
-* ``branch_current[k]`` is the current flowing from node ``edges[k, 0]`` to node
-  ``edges[k, 1]``: w = c (u_i - u_j) = -C A u.
+* ``branch_current[k]`` flows from node ``edges[k, 0]`` to node ``edges[k, 1]``:
+  w = c (u_i - u_j).
 * ``electrode_current[name]`` is the current the external circuit feeds *into the network*
   at that electrode (positive at the high-potential electrode of a resistor).
-* R_eq(a, b) = (V_a - V_b) / I_a.
 
-Floating clusters (connected parts of the network with no fixed-potential electrode and no
-current) carry no current; their potential is undefined, it is set to 0 V and flagged in
-``PotentialSolution.floating`` (a warning says how many nodes). A part with an imposed
+Connected parts with no electrode, and parts whose only electrodes carry imposed currents
+that are all 0, are floating: their potential is undefined, set to 0 V and flagged in
+``PotentialSolution.floating`` (a warning says how many nodes). A part with a non-zero imposed
 current and no fixed-potential electrode has no return path and raises.
+
+Units: SI (S, V, A, ohm, W).
 """
 from __future__ import annotations
 
@@ -33,20 +53,19 @@ from typing import Dict, Mapping, Optional, Sequence
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from scipy.sparse.csgraph import connected_components
 
+from .condensation import ReducedSystem
 from .errors import BoundaryConditionError, MaterialError, SolverError
+from .materials import real_number
+from .solvers import make_solver
 
 __all__ = ["Electrode", "PotentialSolution", "ConductionProblem", "laplacian", "solve_potential", "edge_power",
-           "equivalent_resistance", "make_solver", "DirectSolver", "CGSolver", "solver_names"]
+           "equivalent_resistance", "network_components", "electrode_value", "edge_slots"]
 
 log = logging.getLogger(__name__)
 
 
-# ---------------------------------------------------------------------------------------
-# assembly
-# ---------------------------------------------------------------------------------------
 def laplacian(edges, conductance, n_nodes: int) -> sp.csr_matrix:
     """K = A^T C A of a network [S]: symmetric, rows summing to zero.
 
@@ -68,174 +87,52 @@ def laplacian(edges, conductance, n_nodes: int) -> sp.csr_matrix:
     return sp.csr_matrix((vals, (rows, cols)), shape=(n_nodes, n_nodes))
 
 
-# ---------------------------------------------------------------------------------------
-# solvers: one protocol, solve(A, b, x0=None) -> (x, info); setup kept while A is the same object
-# ---------------------------------------------------------------------------------------
-class _Solver:
-    name = "?"
-
-    def __init__(self):
-        self._A = None
-        self.setup_time = 0.0
-
-    def _ensure_setup(self, A):
-        if A is not self._A:
-            t = time.perf_counter()
-            self._setup(A)
-            self._A = A
-            self.setup_time = time.perf_counter() - t
-            return True
-        return False
-
-    def _setup(self, A):  # pragma: no cover - abstract
-        raise NotImplementedError
-
-    @staticmethod
-    def _residual(A, x, b):
-        nb = np.linalg.norm(b)
-        r = np.linalg.norm(A @ x - b)
-        return r / nb if nb > 0 else r
+def network_components(n_nodes: int, edges, conducting=None) -> tuple:
+    """(count, label per node) of the connected parts of a network, through the edges where
+    ``conducting`` (default: all) is true."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if conducting is not None:
+        edges = edges[np.asarray(conducting, bool)]
+    adj = sp.coo_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n_nodes, n_nodes))
+    return connected_components(adj, directed=False)
 
 
-class DirectSolver(_Solver):
-    """Sparse LU (SuperLU, COLAMD ordering) of the reduced SPD system; the factorisation is
-    kept and reused while the matrix object is unchanged. Exact to rounding."""
-
-    name = "direct"
-
-    def _setup(self, A):
-        self._lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
-
-    def solve(self, A, b, x0=None):
-        fresh = self._ensure_setup(A)
-        x = self._lu.solve(np.asarray(b, dtype=float))
-        return x, {"solver": self.name, "iterations": 0, "residual": self._residual(A, x, b),
-                   "setup": fresh, "setup_time": self.setup_time}
-
-
-class CGSolver(_Solver):
-    """Preconditioned conjugate gradient (the paper's choice) for the SPD reduced system.
-
-    Parameters
-    ----------
-    rtol : float
-        Stop when ||A x - b|| <= rtol ||b|| (default 1e-10, enough for current conservation
-        to 1e-9 relative).
-    preconditioner : {'amg', 'jacobi', 'none'}
-        'amg' = smoothed-aggregation algebraic multigrid (PyAMG) V-cycle; 'jacobi' = the
-        diagonal. 'amg' falls back to 'jacobi' with a warning when PyAMG is not installed.
-    maxiter : int, optional
-        Default 10 n.
-    """
-
-    name = "cg"
-
-    def __init__(self, rtol: float = 1e-10, preconditioner: str = "jacobi", maxiter: Optional[int] = None):
-        super().__init__()
-        if preconditioner not in ("amg", "jacobi", "none"):
-            raise ValueError(f"preconditioner must be 'amg', 'jacobi' or 'none', got {preconditioner!r}")
-        if not (0 < rtol < 1):
-            raise ValueError(f"rtol must be in (0, 1), got {rtol}")
-        if preconditioner == "amg":
-            try:
-                import pyamg  # noqa: F401
-            except ImportError:
-                warnings.warn("PyAMG is not installed: CG falls back to the Jacobi preconditioner "
-                              "(install it with `make install` or `pip install pyamg`)", stacklevel=2)
-                preconditioner = "jacobi"
-        self.rtol = rtol
-        self.preconditioner = preconditioner
-        self.maxiter = maxiter
-
-    def _setup(self, A):
-        A = sp.csr_matrix(A)
-        self._Acsr = A
-        if self.preconditioner == "amg":
-            import pyamg
-            ml = pyamg.smoothed_aggregation_solver(A, symmetry="symmetric", max_coarse=200)
-            self._M = ml.aspreconditioner(cycle="V")
-        elif self.preconditioner == "jacobi":
-            d = A.diagonal()
-            if np.any(d <= 0):
-                raise SolverError("the matrix has a non-positive diagonal entry: a node with no "
-                                  "conducting edge was left among the unknowns")
-            inv = 1.0 / d
-            self._M = lambda r: inv * r
-        else:
-            self._M = lambda r: r
-
-    def solve(self, A, b, x0=None):
-        fresh = self._ensure_setup(A)
-        A = self._Acsr
-        b = np.asarray(b, dtype=float)
-        n = b.shape[0]
-        nb = np.linalg.norm(b)
-        x = np.zeros(n) if x0 is None else np.array(x0, dtype=float, copy=True)
-        if nb == 0:
-            x[:] = 0.0
-            return x, {"solver": self.name, "iterations": 0, "residual": 0.0, "setup": fresh,
-                       "setup_time": self.setup_time}
-        tol = self.rtol * nb
-        maxiter = self.maxiter or 10 * n + 10
-        M = self._M
-        r = b - A @ x
-        rn = np.linalg.norm(r)
-        it = 0
-        if rn > tol:
-            z = M(r)
-            p = z.copy()
-            rz = r @ z
-            while it < maxiter:
-                it += 1
-                q = A @ p
-                pq = p @ q
-                if pq <= 0:
-                    raise SolverError("CG broke down (p.Ap <= 0): the matrix is not positive definite; "
-                                      "check for negative conductances")
-                a = rz / pq
-                x += a * p
-                r -= a * q
-                rn = np.linalg.norm(r)
-                if rn <= tol:
-                    break
-                z = M(r)
-                rz_new = r @ z
-                p *= rz_new / rz
-                p += z
-                rz = rz_new
-        res = np.linalg.norm(b - A @ x) / nb
-        if not np.all(np.isfinite(x)):
-            raise SolverError("CG produced non-finite potentials; check conductances for inf/nan")
-        if res > 10 * self.rtol:
-            raise SolverError(f"CG did not converge: relative residual {res:.3e} > rtol {self.rtol:g} "
-                              f"after {it} iterations; raise maxiter or use solver='direct'")
-        return x, {"solver": self.name, "preconditioner": self.preconditioner, "iterations": it,
-                   "residual": res, "setup": fresh, "setup_time": self.setup_time}
+def edge_slots(candidates, edges, n_nodes: int):
+    """Positions of the node pairs ``edges`` among ``candidates`` (both (m, 2), any order within a
+    pair), or None when some pair is not a candidate."""
+    c = np.sort(np.asarray(candidates, dtype=np.int64).reshape(-1, 2), axis=1)
+    e = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
+    if e.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    if c.shape[0] == 0:
+        return None
+    kc = c[:, 0] * n_nodes + c[:, 1]
+    ke = e[:, 0] * n_nodes + e[:, 1]
+    order = np.argsort(kc)
+    pos = np.clip(np.searchsorted(kc[order], ke), 0, kc.size - 1)
+    if not np.all(kc[order][pos] == ke):
+        return None
+    return order[pos]
 
 
-_SOLVERS = {"direct": DirectSolver, "cg": CGSolver,
-            "cg-amg": lambda **kw: CGSolver(preconditioner="amg", **kw),
-            "cg-jacobi": lambda **kw: CGSolver(preconditioner="jacobi", **kw)}
-
-
-def solver_names() -> tuple:
-    return tuple(sorted(_SOLVERS))
-
-
-def make_solver(solver="cg", **kw):
-    """A solver object from a name ('cg' = 'cg-jacobi', 'cg-amg', 'direct') or pass an object
-    with a ``solve(A, b, x0=None) -> (x, info)`` method through."""
-    if hasattr(solver, "solve"):
-        return solver
+def electrode_value(name: str, value) -> float:
+    """An electrode potential [V] or current [A] as a finite float, or BoundaryConditionError."""
     try:
-        return _SOLVERS[solver](**kw)
-    except KeyError:
-        raise ValueError(f"unknown solver {solver!r}; known: {', '.join(solver_names())}") from None
+        return real_number(f"electrode {name!r}: value", value, what="a real number (V or A)")
+    except MaterialError as exc:
+        raise BoundaryConditionError(str(exc)) from None
 
 
-# ---------------------------------------------------------------------------------------
-# boundary conditions
-# ---------------------------------------------------------------------------------------
+def edge_power(branch_current, conductance) -> np.ndarray:
+    """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
+    carry no current)."""
+    c = np.asarray(conductance, dtype=float)
+    out = np.zeros_like(c)
+    nz = c > 0
+    out[nz] = np.asarray(branch_current, dtype=float)[nz] ** 2 / c[nz]
+    return out
+
+
 @dataclass(frozen=True)
 class Electrode:
     """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current.
@@ -258,16 +155,19 @@ class Electrode:
     current: Optional[float] = None
 
     def __post_init__(self):
-        nodes = np.unique(np.asarray(self.nodes, dtype=np.int64).reshape(-1))
+        raw = np.asarray(self.nodes).reshape(-1)
+        if raw.size and not (np.issubdtype(raw.dtype, np.integer)):
+            raise BoundaryConditionError(f"electrode {self.name!r}: nodes must be integer indices, got "
+                                         f"{raw[:5].tolist()}")
+        nodes = np.unique(raw.astype(np.int64))
         if nodes.size == 0:
             raise BoundaryConditionError(f"electrode {self.name!r} selects no element: check its "
                                          "predicate/box, ids or mask against the packing")
         if (self.potential is None) == (self.current is None):
             raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
                                          "(fixed potential, V) or current= (imposed current, A)")
-        v = self.potential if self.potential is not None else self.current
-        if not np.isfinite(v):
-            raise BoundaryConditionError(f"electrode {self.name!r}: value must be finite, got {v}")
+        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
+        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
         nodes.setflags(write=False)
         object.__setattr__(self, "nodes", nodes)
 
@@ -280,9 +180,6 @@ class Electrode:
         return float(self.potential if self.fixed else self.current)
 
 
-# ---------------------------------------------------------------------------------------
-# results
-# ---------------------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
 class PotentialSolution:
     """Result of one potential solve (SI units: V, A, ohm).
@@ -292,9 +189,11 @@ class PotentialSolution:
     potential : (n,) node potentials [V] (0 on floating clusters)
     branch_current : (m,) current from ``edges[k,0]`` to ``edges[k,1]`` [A]
     electrode_potential, electrode_current : dict name -> V, A (current fed into the network)
-    floating : (n,) bool, nodes in clusters with no electrode (no current, potential undefined)
-    residual : relative residual ||K x - b|| / ||b|| of the reduced system
+    floating : (n,) bool, nodes in parts with no potential reference (no current, potential 0)
+    residual : largest relative residual of the linear solves behind this solution
     current_imbalance : |sum of electrode currents + injections| / max |electrode current|
+    component_of_electrode : dict name -> connected part label
+    conductance_matrix : (ne, ne) S [S], electrode currents I = S V (+ injection part)
     info : solver information (name, iterations, times)
     """
 
@@ -306,74 +205,89 @@ class PotentialSolution:
     residual: float
     current_imbalance: float
     component_of_electrode: Dict[str, int]
+    conductance_matrix: np.ndarray = None
     info: dict = field(default_factory=dict)
 
     def equivalent_resistance(self, a: str, b: str) -> float:
-        """R_eq = (V_a - V_b) / I_a [ohm] between electrodes a and b; inf when they are not
-        connected (no current flows)."""
+        """R_eq [ohm] between electrodes a and b, the other electrodes left open (floating):
+        a property of the network, exact for any applied values; inf when a and b are not
+        connected."""
+        names = list(self.electrode_current)
         for e in (a, b):
             if e not in self.electrode_current:
-                raise BoundaryConditionError(f"no electrode named {e!r}; have {sorted(self.electrode_current)}")
-        if self.component_of_electrode[a] != self.component_of_electrode[b]:
+                raise BoundaryConditionError(f"no electrode named {e!r}; have {sorted(names)}")
+        if a == b:
+            raise BoundaryConditionError(f"R_eq needs two different electrodes, got {a!r} twice")
+        comp = self.component_of_electrode
+        if comp[a] != comp[b]:
             return float("inf")
-        dv = self.electrode_potential[a] - self.electrode_potential[b]
-        i = self.electrode_current[a]
-        scale = max(abs(v) for v in self.electrode_current.values()) or 1.0
-        if abs(i) <= 1e-14 * scale or i == 0.0:
-            return float("inf") if dv != 0 else float("nan")
-        return dv / i
+        return _two_terminal_resistance(self.conductance_matrix, names, comp, a, b)
 
     def joule_power(self, conductance) -> np.ndarray:
         """Power dissipated in each edge, w^2 / c [W] (see :func:`edge_power`)."""
         return edge_power(self.branch_current, conductance)
 
 
-def edge_power(branch_current, conductance) -> np.ndarray:
-    """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
-    carry no current)."""
-    c = np.asarray(conductance, dtype=float)
-    out = np.zeros_like(c)
-    nz = c > 0
-    out[nz] = np.asarray(branch_current, dtype=float)[nz] ** 2 / c[nz]
-    return out
+def _two_terminal_resistance(S, names, comp, a, b) -> float:
+    idx = [k for k, nm in enumerate(names) if comp[nm] == comp[a]]
+    ia, ib = names.index(a), names.index(b)
+    others = [k for k in idx if k not in (ia, ib)]
+    Saa = S[np.ix_([ia, ib], [ia, ib])]
+    if others:
+        Sao = S[np.ix_([ia, ib], others)]
+        Soo = S[np.ix_(others, others)]
+        Saa = Saa - Sao @ np.linalg.solve(Soo, Sao.T)
+    g = 0.5 * (Saa[0, 0] + Saa[1, 1] - Saa[0, 1] - Saa[1, 0]) / 2.0
+    scale = float(np.max(np.abs(S))) if S.size else 0.0
+    if not g > 1e-14 * scale:
+        return float("inf")
+    return float(1.0 / g)
 
 
-# ---------------------------------------------------------------------------------------
-# the problem: structure (graph, conductances, electrode node sets) fixed, values free
-# ---------------------------------------------------------------------------------------
+def _ro(a):
+    a = np.asarray(a)
+    a.setflags(write=False)
+    return a
+
+
 class ConductionProblem:
-    """Reduced Kirchhoff system of a network with electrodes, kept for repeated solves.
+    """Kirchhoff network with electrodes, kept for repeated solves (see module doc).
 
-    Building it checks the boundary conditions and the cluster structure; ``solve`` can then
-    be called many times with other electrode values (and reuses the solver's setup and the
-    previous solution as starting guess).
+    Building it checks the electrodes and the connected parts. Then:
+
+    * :meth:`solve` with other electrode values costs no linear solve;
+    * :meth:`update_conductance` with new values on the same edges updates the matrices in
+      place, keeps the solver setup (``solver.update``) and re-solves warm at the next
+      :meth:`solve`; the structure is rebuilt only when the connected parts change (an edge
+      dropped to 0 that splits the network, or one that joins two parts);
+    * :meth:`update_edges` takes a new edge set: a subset of the current one (bonds broke) is
+      a value update with zeros; other sets rebuild the structure.
 
     Parameters
     ----------
     n_nodes : int
     edges : (m, 2) int array
-    conductance : (m,) array [S]
+    conductance : (m,) array [S], >= 0
     electrodes : sequence of Electrode
-    injection : (n,) array of currents injected into nodes [A], optional
-    solver : name or solver object (see ``make_solver``)
+    injection : (n,) currents injected into nodes [A], optional
+    solver : name or solver object (see :mod:`yade_electro.solvers`); 'auto' by size
+    coords : (n, 3) node positions [m], optional (for the coarse space of 'cg-deflated')
     """
 
     def __init__(self, n_nodes: int, edges, conductance, electrodes: Sequence[Electrode],
-                 injection=None, solver="cg"):
+                 injection=None, solver="auto", coords=None):
         self.n = n = int(n_nodes)
         self.edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        c = np.asarray(conductance, dtype=float)
-        if c.shape != (self.edges.shape[0],):
-            raise ValueError(f"conductance must have one value per edge ({self.edges.shape[0]}), got {c.shape}")
-        if not np.all(np.isfinite(c)) or np.any(c < 0):
-            raise MaterialError("conductances must be finite and >= 0 (check resistivity and radii)")
-        self.c = c
+        if self.edges.size and (self.edges.min() < 0 or self.edges.max() >= n):
+            raise ValueError(f"edge node index out of range 0..{n - 1}")
+        self.c = self._check_conductance(conductance)
         self.electrodes = list(electrodes)
         if not self.electrodes:
             raise BoundaryConditionError("no electrode given: at least one fixed-potential electrode is needed")
         names = [e.name for e in self.electrodes]
         if len(set(names)) != len(names):
             raise BoundaryConditionError(f"electrode names must be unique, got {names}")
+        self.names = names
         owner = np.full(n, -1, dtype=np.int64)
         for k, e in enumerate(self.electrodes):
             outside = e.nodes[(e.nodes < 0) | (e.nodes >= n)]
@@ -387,148 +301,282 @@ class ConductionProblem:
                     f"{clash.size} element(s) belong to both electrodes {other!r} and {e.name!r} "
                     f"(e.g. node {clash[0]}); make the selections disjoint")
             owner[e.nodes] = k
+        self._owner = owner
         self.injection = None
         if injection is not None:
             f = np.asarray(injection, dtype=float)
             if f.shape != (n,) or not np.all(np.isfinite(f)):
                 raise BoundaryConditionError(f"injection must be a finite array of shape ({n},)")
-            self.injection = f
-        self._owner = owner
+            self.injection = f if np.any(f != 0) else None
+        self.coords = None if coords is None else np.asarray(coords, dtype=float)
+        self._solver_spec = solver
+        self.solver = None
+        self.structure_builds = 0
+        self.value_updates = 0
+        self.basis_solves = 0
+        self._phi = None                 # (nu, ne) characteristic potentials, warm start
         self._build()
-        self.solver = make_solver(solver)
-        self._x_prev = None
+        self._check_return_paths([e.value for e in self.electrodes])
+
+    # -- structure ------------------------------------------------------------------------
+    def _check_conductance(self, conductance):
+        c = np.asarray(conductance, dtype=float)
+        if c.shape != (self.edges.shape[0],):
+            raise ValueError(f"conductance must have one value per edge ({self.edges.shape[0]}), got {c.shape}")
+        if not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise MaterialError("conductances must be finite and >= 0 (check resistivity and radii)")
+        return c
+
+    def _components(self, c):
+        """Connected parts through conducting edges, electrodes counted as super-nodes."""
+        n, ne = self.n, len(self.electrodes)
+        # tie each electrode's nodes through a virtual node n + k
+        el_nodes = np.flatnonzero(self._owner >= 0)
+        ties = np.column_stack([el_nodes, self.n + self._owner[el_nodes]])
+        e = np.concatenate([self.edges[c > 0], ties])
+        ncomp, label = network_components(n + ne, e)
+        return label[:n], label[n:]
 
     def _build(self):
-        n, ne = self.n, len(self.electrodes)
-        owner = self._owner
-        free = np.flatnonzero(owner < 0)
-        nf = free.size
-        # reduced index of every node: free nodes first, then one super-node per electrode
-        ridx = np.empty(n, dtype=np.int64)
-        ridx[free] = np.arange(nf)
-        ridx[owner >= 0] = nf + owner[owner >= 0]
-        nr = nf + ne
-        re = ridx[self.edges]
-        keep = (re[:, 0] != re[:, 1]) & (self.c > 0)
-        Kr = laplacian(re[keep], self.c[keep], nr)
-        ncomp, label = connected_components(Kr, directed=False)
-        fixed = np.array([e.fixed for e in self.electrodes], dtype=bool)
-        el_rows = nf + np.arange(ne)
-        comp_fixed = np.zeros(ncomp, dtype=bool)
-        comp_fixed[label[el_rows[fixed]]] = True
-        # currents without a return path
-        comp_current = np.zeros(ncomp, dtype=bool)
-        for k, e in enumerate(self.electrodes):
-            if not e.fixed and e.current != 0:
-                comp_current[label[el_rows[k]]] = True
-        if self.injection is not None:
-            nzf = np.flatnonzero(self.injection[free] != 0)
-            comp_current[label[nzf]] = True
-        bad = comp_current & ~comp_fixed
-        if np.any(bad):
-            names = [e.name for k, e in enumerate(self.electrodes) if bad[label[el_rows[k]]] and not e.fixed]
-            raise BoundaryConditionError(
-                "an imposed current has no return path: a connected part of the network carries an "
-                f"imposed current (electrodes {names or 'none; node injections'}) but no fixed-potential "
-                "electrode; ground one electrode (potential=0) in that part")
-        solved = comp_fixed[label]
-        unknown = solved.copy()
-        unknown[el_rows[fixed]] = False
-        self._nf, self._nr, self._ridx, self._free = nf, nr, ridx, free
-        self._Kr, self._label = Kr, label
-        self._unknown = np.flatnonzero(unknown)
-        self._dirichlet = el_rows[fixed]
-        self._fixed = fixed
-        Kr_csr = Kr.tocsr()
-        self._Kuu = Kr_csr[self._unknown][:, self._unknown].tocsr()
-        self._Kud = Kr_csr[self._unknown][:, self._dirichlet].tocsr()
-        self._floating_r = ~solved
-        self.floating = self._floating_r[ridx]
-        nfl = int(self.floating.sum())
+        n = self.n
+        node_label, el_label = self._components(self.c)
+        has_el = np.zeros(node_label.max() + 1 if n else 1, bool)
+        has_el[el_label] = True
+        exclude = ~has_el[node_label]
+        old_phi = self._phi
+        old_sys = getattr(self, "system", None)
+        self.system = ReducedSystem(n, self.edges, [e.nodes for e in self.electrodes], exclude=exclude)
+        self.system.assemble(self.c)
+        self._node_label, self._el_label = node_label, el_label
+        self._exclude = exclude
+        nfl = int(exclude.sum())
+        self.floating_structural = exclude
         if nfl:
-            ncl = np.unique(label[~solved]).size
-            warnings.warn(f"{nfl} element(s) in {ncl} cluster(s) are connected to no fixed-potential "
-                          "electrode: they carry no current and their potential is set to 0 V "
-                          "(see PotentialSolution.floating)", stacklevel=3)
-        self.component_of_electrode = {e.name: int(label[el_rows[k]]) for k, e in enumerate(self.electrodes)}
+            ncl = np.unique(node_label[exclude]).size
+            warnings.warn(f"{nfl} element(s) in {ncl} cluster(s) are connected to no electrode: they carry "
+                          "no current and their potential is set to 0 V (see PotentialSolution.floating)",
+                          stacklevel=4)
+        nu = self.system.n_unknowns
+        if self.solver is None or isinstance(self._solver_spec, str):
+            self.solver = make_solver(self._solver_spec, n_unknowns=nu)
+        if self.coords is not None:
+            X = self.coords[self.system.unknown_nodes]
+            spacing = self._spacing()
+            self.solver.set_geometry(X, spacing)
+        # warm start carried over through node potentials
+        if old_phi is not None and old_sys is not None:
+            phi = np.zeros((nu, len(self.electrodes)))
+            keep = old_sys.unknown_index[self.system.unknown_nodes]
+            ok = keep >= 0
+            phi[ok] = old_phi[keep[ok]]
+            self._phi = phi
+        else:
+            self._phi = None
+        self._basis_valid = False
+        self._last = None
+        self.structure_builds += 1
+        # per part: its electrodes and unknowns
+        self._parts = {}
+        ulab = node_label[self.system.unknown_nodes]
+        for k, lab in enumerate(el_label):
+            self._parts.setdefault(int(lab), []).append(k)
+        self._part_unknowns = {lab: np.flatnonzero(ulab == lab) for lab in self._parts}
+        self.component_of_electrode = {e.name: int(el_label[k]) for k, e in enumerate(self.electrodes)}
 
-    def solve(self, values: Optional[Mapping[str, float]] = None, x0=None) -> PotentialSolution:
-        """Solve for the potentials.
+    def _spacing(self):
+        e = self.edges[self.c > 0]
+        if e.size == 0:
+            return None
+        d = self.coords[e[:, 1]] - self.coords[e[:, 0]]
+        return float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d))))
 
-        Parameters
-        ----------
-        values : mapping name -> value, optional
-            New potentials [V] / currents [A] for some electrodes (kind unchanged).
-        x0 : initial guess of the unknown reduced potentials; default the previous solution.
-        """
+    def update_conductance(self, conductance) -> str:
+        """New conductances on the same edges [S]. Returns 'values' (in-place update, solver
+        setup kept) or 'structure' (the connected parts changed: rebuilt)."""
+        c = self._check_conductance(conductance)
+        same_parts = np.array_equal(c > 0, self.c > 0)
+        self.c = c
+        self._last = None
+        self._basis_valid = False
+        if not same_parts:
+            node_label, el_label = self._components(c)
+            if self._same_partition(node_label, el_label):
+                same_parts = True
+        if same_parts:
+            Kuu, _ = self.system.assemble(c)
+            self.solver.update(Kuu)
+            self.value_updates += 1
+            return "values"
+        self._build()
+        return "structure"
+
+    def _same_partition(self, node_label, el_label) -> bool:
+        """True when the new parts give the same unknowns and the same electrodes per part."""
+        has_el = np.zeros(node_label.max() + 1, bool)
+        has_el[el_label] = True
+        if not np.array_equal(~has_el[node_label], self._exclude):
+            return False
+        # electrodes grouped the same way
+        old, new = self._el_label, el_label
+        return bool(np.array_equal(old[:, None] == old[None, :], new[:, None] == new[None, :]))
+
+    def update_edges(self, edges, conductance) -> str:
+        """A new edge set with its conductances. A subset of the current edges keeps the
+        structure (the missing edges get conductance 0); anything else rebuilds it."""
+        edges = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
+        c_new = np.asarray(conductance, dtype=float)
+        if c_new.shape != (edges.shape[0],):
+            raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {c_new.shape}")
+        slots = edge_slots(self.edges, edges, self.n)
+        if slots is not None:
+            c = np.zeros(self.edges.shape[0])
+            c[slots] = c_new
+            return self.update_conductance(c)
+        self.edges = edges
+        self.c = self._check_conductance(c_new)
+        self._build()
+        return "structure"
+
+    # -- solving ----------------------------------------------------------------------------
+    def _basis(self):
+        """phi (nu, ne) and S (ne, ne) for the current conductances (solved when stale)."""
+        if self._basis_valid:
+            return
+        sys_ = self.system
+        nu, ne = sys_.n_unknowns, len(self.electrodes)
+        phi = np.zeros((nu, ne)) if self._phi is None else self._phi
+        residual, iterations = 0.0, 0
+        t = time.perf_counter()
+        Kuu, Kud = sys_.Kuu, sys_.Kud
+        for lab, ks in self._parts.items():
+            rows = self._part_unknowns[lab]
+            if rows.size == 0:
+                continue
+            for k in ks[:-1]:
+                b = -np.asarray(Kud[:, k].todense()).ravel()
+                x0 = phi[:, k]
+                x, info = self.solver.solve(Kuu, b, x0=x0)
+                phi[:, k] = x
+                residual = max(residual, float(info.get("residual", 0.0)))
+                iterations += int(info.get("iterations", 0))
+                self.basis_solves += 1
+            last = ks[-1]
+            phi[:, last] = 0.0
+            phi[rows, last] = 1.0 - (phi[rows][:, ks[:-1]].sum(axis=1) if len(ks) > 1 else 0.0)
+        if not np.all(np.isfinite(phi)):
+            raise SolverError("the potential solve returned non-finite values")
+        self._phi = phi
+        S = sys_.Kdd.toarray() + (sys_.Kdu @ phi if nu else 0.0)
+        self._S = 0.5 * (S + S.T)
+        self._u_inj, self._j_inj = None, np.zeros(ne)
+        if self.injection is not None:
+            f_u = self.injection[sys_.unknown_nodes]
+            x, info = self.solver.solve(Kuu, f_u, x0=getattr(self, "_u_inj_prev", None))
+            self._u_inj = self._u_inj_prev = x
+            residual = max(residual, float(info.get("residual", 0.0)))
+            iterations += int(info.get("iterations", 0))
+            f_g = np.bincount(self._owner[self._owner >= 0], self.injection[self._owner >= 0], ne)
+            self._j_inj = (sys_.Kdu @ x if nu else np.zeros(ne)) - f_g
+        self._basis_info = {"solver": getattr(self.solver, "name", type(self.solver).__name__),
+                            "iterations": iterations, "residual": residual,
+                            "basis_time": time.perf_counter() - t, "n_unknowns": int(nu)}
+        self._basis_valid = True
+
+    def _check_return_paths(self, vals):
+        fixed = np.array([e.fixed for e in self.electrodes])
+        for lab, ks in self._parts.items():
+            if fixed[ks].any():
+                continue
+            inj = 0.0
+            if self.injection is not None:
+                inj = np.abs(self.injection[self._node_label == lab]).sum()
+            if any(vals[k] != 0 for k in ks) or inj > 0:
+                names = [self.names[k] for k in ks]
+                raise BoundaryConditionError(
+                    "an imposed current has no return path: a connected part of the network carries an "
+                    f"imposed current (electrodes {names}{' and node injections' if inj else ''}) but no "
+                    "fixed-potential electrode; ground one electrode (potential=0) in that part")
+        if self.injection is not None:
+            lone = self._exclude & (self.injection != 0)
+            if np.any(lone):
+                raise BoundaryConditionError(
+                    "an imposed current has no return path: node injections fall on a part of the network "
+                    "with no electrode (node injections); connect it or ground it")
+
+    def solve(self, values: Optional[Mapping[str, float]] = None) -> PotentialSolution:
+        """Potentials and currents for electrode ``values`` (name -> V or A; default the
+        electrodes' own values). Costs a linear solve only when the conductances changed."""
         t0 = time.perf_counter()
-        vals = np.array([e.value for e in self.electrodes], dtype=float)
+        vals = [e.value for e in self.electrodes]
         if values:
-            idx = {e.name: k for k, e in enumerate(self.electrodes)}
+            idx = {nm: k for k, nm in enumerate(self.names)}
             for name, v in values.items():
                 if name not in idx:
                     raise BoundaryConditionError(f"no electrode named {name!r}; have {sorted(idx)}")
-                if not np.isfinite(v):
-                    raise BoundaryConditionError(f"electrode {name!r}: value must be finite, got {v}")
-                vals[idx[name]] = float(v)
-        nf, nr = self._nf, self._nr
-        # right-hand side on the reduced nodes
-        f_r = np.zeros(nr)
-        if self.injection is not None:
-            np.add.at(f_r, self._ridx, self.injection)
-        f_r[nf:][~self._fixed] += vals[~self._fixed]
-        xd = vals[self._fixed]
-        b = f_r[self._unknown] - self._Kud @ xd
-        if x0 is None:
-            x0 = self._x_prev
-        if self._unknown.size:
-            xu, info = self.solver.solve(self._Kuu, b, x0=x0)
-        else:
-            xu, info = np.zeros(0), {"solver": "none", "iterations": 0, "residual": 0.0}
-        if not np.all(np.isfinite(xu)):
-            raise SolverError("the potential solve returned non-finite values")
-        self._x_prev = xu
-        x = np.zeros(nr)
-        x[self._unknown] = xu
-        x[self._dirichlet] = xd
-        u = x[self._ridx]
-        i, j = self.edges[:, 0], self.edges[:, 1]
-        w = self.c * (u[i] - u[j])
-        net = self._Kr @ x                      # current leaving each reduced node into the bonds
-        el_rows = nf + np.arange(len(self.electrodes))
-        # net current leaving an electrode into the network = external feed + node injections on it
-        inj_el = f_r[el_rows] - np.where(self._fixed, 0.0, vals)
-        el_current = np.where(self._fixed, net[el_rows] - inj_el, vals)
-        el_pot = x[el_rows]
-        total_in = el_current.sum() + (self.injection.sum() if self.injection is not None else 0.0)
-        scale = np.max(np.abs(el_current)) if el_current.size else 0.0
+                vals[idx[name]] = electrode_value(name, v)
+        key = tuple(vals)
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        self._check_return_paths(vals)
+        self._basis()
+        fixed = np.array([e.fixed for e in self.electrodes])
+        vals = np.asarray(vals, dtype=float)
+        S, j = self._S, self._j_inj
+        V = np.where(fixed, vals, 0.0)
+        floating_parts = []
+        for lab, ks in self._parts.items():
+            ks = np.asarray(ks)
+            cur = ks[~fixed[ks]]
+            fix = ks[fixed[ks]]
+            if cur.size == 0:
+                continue
+            if fix.size == 0:            # all currents zero (checked above): no reference
+                floating_parts.append(lab)
+                continue
+            rhs = vals[cur] - S[np.ix_(cur, fix)] @ V[fix] - j[cur]
+            V[cur] = np.linalg.solve(S[np.ix_(cur, cur)], rhs)
+        sys_ = self.system
+        xu = self._phi @ V if sys_.n_unknowns else np.zeros(0)
+        if self._u_inj is not None:
+            xu = xu + self._u_inj
+        u = sys_.expand(xu, V)
+        floating = self._exclude.copy()
+        for lab in floating_parts:
+            floating |= self._node_label == lab
+        u[floating] = 0.0
+        w = self.c * (u[self.edges[:, 0]] - u[self.edges[:, 1]])
+        I = np.where(fixed, S @ V + j, vals)
+        I[np.isin(self._el_label, floating_parts)] = 0.0
+        total_in = I.sum() + (self.injection.sum() if self.injection is not None else 0.0)
+        scale = float(np.max(np.abs(I))) if I.size else 0.0
         imbalance = abs(total_in) / scale if scale > 0 else 0.0
-        info = dict(info)
+        info = dict(self._basis_info)
         info["solve_time"] = time.perf_counter() - t0
-        info["n_unknowns"] = int(self._unknown.size)
-        return PotentialSolution(
+        info["setup"] = bool(getattr(self.solver, "n_setups", 0))
+        sol = PotentialSolution(
             potential=_ro(u), branch_current=_ro(w),
-            electrode_potential={e.name: float(el_pot[k]) for k, e in enumerate(self.electrodes)},
-            electrode_current={e.name: float(el_current[k]) for k, e in enumerate(self.electrodes)},
-            floating=_ro(self.floating.copy()), residual=float(info.get("residual", 0.0)),
-            current_imbalance=float(imbalance), component_of_electrode=dict(self.component_of_electrode),
+            electrode_potential={nm: float(V[k]) for k, nm in enumerate(self.names)},
+            electrode_current={nm: float(I[k]) for k, nm in enumerate(self.names)},
+            floating=_ro(floating), residual=float(info["residual"]), current_imbalance=float(imbalance),
+            component_of_electrode=dict(self.component_of_electrode), conductance_matrix=_ro(S.copy()),
             info=info)
+        self._last = (key, sol)
+        return sol
 
-
-def _ro(a):
-    a = np.asarray(a)
-    a.setflags(write=False)
-    return a
+    @property
+    def floating(self) -> np.ndarray:
+        """Nodes in parts with no electrode (bool, (n,))."""
+        return self._exclude
 
 
 def solve_potential(n_nodes: int, edges, conductance, electrodes: Sequence[Electrode], injection=None,
-                    solver="cg") -> PotentialSolution:
+                    solver="auto") -> PotentialSolution:
     """One-shot potential solve; see :class:`ConductionProblem` to solve repeatedly."""
     return ConductionProblem(n_nodes, edges, conductance, electrodes, injection, solver).solve()
 
 
-def equivalent_resistance(n_nodes: int, edges, conductance, nodes_a, nodes_b, solver="cg") -> float:
-    """R_eq [ohm] between two node sets held at 1 V and 0 V (inf if they are not connected)."""
+def equivalent_resistance(n_nodes: int, edges, conductance, nodes_a, nodes_b, solver="auto") -> float:
+    """R_eq [ohm] between two node sets (inf if they are not connected)."""
     sol = solve_potential(n_nodes, edges, conductance,
                           [Electrode("a", nodes_a, potential=1.0), Electrode("b", nodes_b, potential=0.0)],
                           solver=solver)

@@ -46,15 +46,21 @@ from dataclasses import dataclass, field
 from typing import Any, Optional, Sequence
 
 import numpy as np
-import scipy.sparse as sp
 
-from .conductance import conductance
-from .errors import BoundaryConditionError, MaterialError, ThermalError
+from .condensation import ReducedSystem
+from .conductance import make_law
+from .errors import BoundaryConditionError, MaterialError, SolverError, ThermalError
 from .graph import ContactGraph
-from .network import edge_power, laplacian, make_solver
+from .materials import edge_conductivity, positive_property, real_number
+from .network import edge_power, edge_slots
+from .selection import check_selector, select_nodes
+from .solvers import CGSolver, DirectSolver, make_solver
+
+_OWN_SOLVERS = (CGSolver, DirectSolver)
 from .surfaces import eccentricity, volume_fraction as _volume_fraction
 
 __all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
+           "resolve_nodes", "resolve_area",
            "exposed_area", "stable_time_step", "diffusion_time_step", "theta_of",
            "FixedTemperature", "HeatFlux", "Convection", "ThermalState", "HeatStep", "HeatSolver"]
 
@@ -67,18 +73,6 @@ _THETA_NAMES = {"explicit": 0.0, "forward-euler": 0.0, "crank-nicolson": 0.5,
 # ---------------------------------------------------------------------------------------
 # material input
 # ---------------------------------------------------------------------------------------
-def _positive(name: str, value, n: Optional[int], unit: str = "") -> np.ndarray:
-    """``value`` as a float scalar or (n,) array, or MaterialError if not finite and > 0."""
-    a = np.asarray(value, dtype=float)
-    if a.ndim not in (0, 1) or (a.ndim == 1 and n is not None and a.shape[0] != n):
-        raise MaterialError(f"{name} must be a scalar or one value per element ({n}), got shape {a.shape}")
-    ok = np.isfinite(a) & (a > 0)
-    if not np.all(ok):
-        bad = a if a.ndim == 0 else a[~ok][:5]
-        raise MaterialError(f"{name} must be finite and > 0{unit}; got {np.atleast_1d(bad).tolist()}")
-    return a
-
-
 def heat_capacity(graph: ContactGraph, density, specific_heat, volume_fraction=None, cell_volume=None,
                   threshold: float = 0.4, factor: float = 2.0) -> np.ndarray:
     """Heat capacity C_i of every element [J/K].
@@ -105,32 +99,32 @@ def heat_capacity(graph: ContactGraph, density, specific_heat, volume_fraction=N
         A non-positive or non-finite density, specific heat, volume fraction or cell volume.
     """
     n = graph.n_nodes
-    rc = _positive("density", density, n, " (kg/m^3)") * _positive("specific_heat", specific_heat, n,
+    rc = positive_property("density", density, n, " (kg/m^3)") * positive_property("specific_heat", specific_heat, n,
                                                                       " (J/(kg K))")
     if cell_volume is not None:
         if volume_fraction is not None:
             raise ValueError("give volume_fraction= or cell_volume=, not both")
-        v = _positive("cell_volume", cell_volume, n, " (m^3)")
+        v = positive_property("cell_volume", cell_volume, n, " (m^3)")
         return np.broadcast_to(rc * v, (n,)).astype(float)
     if volume_fraction is None:
         fv = _volume_fraction(graph, threshold=threshold, factor=factor)
     else:
-        fv = _positive("volume_fraction", volume_fraction, n)
+        fv = positive_property("volume_fraction", volume_fraction, n)
     return np.broadcast_to(rc * graph.volume / fv, (n,)).astype(float)
 
 
-def thermal_conductance(graph: ContactGraph, conductivity, law: str = "continuum", **params) -> np.ndarray:
-    """Thermal conductance G_ij of every edge [W/K]: the electrical law ``law`` called with the
-    thermal resistivity 1/lambda. For 'continuum' it is ``lambda S_ij / l_ij`` (paper 000
-    eq. 16); per-node conductivities make an edge two half rods in series.
+def thermal_conductance(graph: ContactGraph, conductivity, law="continuum", **params) -> np.ndarray:
+    """Thermal conductance G_ij of every edge of ``graph`` [W/K]: ``lambda_edge g`` with the
+    law's geometric factor g (for 'continuum', ``lambda S_ij / l_ij``, paper 000 eq. 16);
+    per-node conductivities make an edge two half rods in series (harmonic mean).
 
     Raises
     ------
     MaterialError
         A non-positive or non-finite conductivity [W/(m K)].
     """
-    lam = _positive("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
-    return conductance(graph, 1.0 / lam, law, **params)
+    lam = positive_property("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
+    return edge_conductivity(lam, graph.edges) * make_law(law, **params).factor(graph, graph.edges)
 
 
 def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_heat) -> float:
@@ -138,8 +132,8 @@ def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_hea
     over the nodes when properties vary). For comparison with :func:`stable_time_step`,
     which is the bound the integrators use."""
     n = graph.n_nodes
-    alpha = (_positive("thermal conductivity", conductivity, n) /
-             (_positive("density", density, n) * _positive("specific_heat", specific_heat, n)))
+    alpha = (positive_property("thermal conductivity", conductivity, n) /
+             (positive_property("density", density, n) * positive_property("specific_heat", specific_heat, n)))
     if graph.n_edges == 0:
         return math.inf
     return float(np.min(graph.length) ** 2 / (2.0 * np.max(alpha)))
@@ -197,9 +191,26 @@ def exposed_area(graph: ContactGraph, threshold: float = 0.4) -> np.ndarray:
 
 
 def _finite(name, v):
-    if v is None or not np.isfinite(v):
-        raise BoundaryConditionError(f"{name} must be a finite number, got {v}")
-    return float(v)
+    try:
+        return real_number(name, v)
+    except MaterialError as exc:
+        raise BoundaryConditionError(str(exc)) from None
+
+
+def _check_bc(bc, kind):
+    if not isinstance(bc.name, str) or not bc.name:
+        raise BoundaryConditionError(f"{kind} boundary condition names must be non-empty strings, got {bc.name!r}")
+    check_selector(bc.nodes, f"{kind} boundary condition {bc.name!r}: nodes")
+    area = getattr(bc, "area", None)
+    if area is not None and not callable(area):
+        try:
+            a = np.asarray(area, dtype=float)
+        except (TypeError, ValueError):
+            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: area must be a number or an array "
+                                         f"of areas (m^2), got {area!r}") from None
+        if a.ndim > 1 or not np.all(np.isfinite(a)) or np.any(a < 0):
+            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: areas must be finite and >= 0 "
+                                         "(m^2), a scalar or one per element")
 
 
 @dataclass(frozen=True)
@@ -215,7 +226,9 @@ class FixedTemperature:
     temperature: float
 
     def __post_init__(self):
-        _finite(f"fixed temperature {self.name!r}: temperature", self.temperature)
+        _check_bc(self, "fixed-temperature")
+        object.__setattr__(self, "temperature",
+                           _finite(f"fixed-temperature boundary condition {self.name!r}: temperature", self.temperature))
 
 
 @dataclass(frozen=True)
@@ -234,10 +247,13 @@ class HeatFlux:
     area: Any = None
 
     def __post_init__(self):
+        _check_bc(self, "heat-flux")
         if (self.power is None) == (self.flux is None):
-            raise BoundaryConditionError(f"heat flux {self.name!r}: give exactly one of power= (W, total) "
-                                         "or flux= (W/m^2)")
-        _finite(f"heat flux {self.name!r}: value", self.power if self.power is not None else self.flux)
+            raise BoundaryConditionError(f"heat-flux boundary condition {self.name!r}: give exactly one of power= "
+                                         "(W, total) or flux= (W/m^2)")
+        field_ = "power" if self.power is not None else "flux"
+        object.__setattr__(self, field_, _finite(f"heat-flux boundary condition {self.name!r}: {field_}",
+                                                 getattr(self, field_)))
 
 
 @dataclass(frozen=True)
@@ -252,21 +268,25 @@ class Convection:
     area: Any = None
 
     def __post_init__(self):
-        if not (np.isfinite(self.h) and self.h >= 0):
-            raise MaterialError(f"convection {self.name!r}: h must be finite and >= 0 (W/(m^2 K)), got {self.h}")
-        _finite(f"convection {self.name!r}: t_inf", self.t_inf)
-
-
-def _resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
-    if graph is not None:
-        from .engine import select_nodes  # local: engine is the higher layer
+        _check_bc(self, "convection")
         try:
-            return np.unique(select_nodes(graph, bc.nodes, bc.name))
-        except BoundaryConditionError as exc:
-            raise BoundaryConditionError(f"thermal boundary condition: {exc}") from None
+            h = real_number(f"convection boundary condition {self.name!r}: h", self.h)
+        except MaterialError as exc:
+            raise MaterialError(f"{exc} (W/(m^2 K))") from None
+        if h < 0:
+            raise MaterialError(f"convection boundary condition {self.name!r}: h must be >= 0 (W/(m^2 K)), got {h}")
+        object.__setattr__(self, "h", h)
+        object.__setattr__(self, "t_inf", _finite(f"convection boundary condition {self.name!r}: t_inf", self.t_inf))
+
+
+def resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
+    """Node indices of a boundary condition's ``nodes`` (a selector with a graph, else node
+    indices or a mask); BoundaryConditionError when it selects nothing."""
+    if graph is not None:
+        return select_nodes(graph, bc.nodes, bc.name, "thermal boundary condition")
     if callable(bc.nodes):
-        raise BoundaryConditionError(f"{bc.name!r}: a selector needs a graph; give node indices or use "
-                                     "HeatSolver.from_graph")
+        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: a selector needs a graph; give "
+                                     "node indices or use HeatSolver.from_graph")
     a = np.asarray(bc.nodes)
     if a.dtype == bool:
         if a.shape != (n,):
@@ -281,11 +301,11 @@ def _resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
     return nodes
 
 
-def _resolve_area(bc, nodes, n, default_area) -> np.ndarray:
+def resolve_area(bc, nodes, n, default_area) -> np.ndarray:
     if bc.area is None:
         if default_area is None:
-            raise BoundaryConditionError(f"{bc.name!r}: no area given and no graph to estimate the exposed "
-                                         "area from; pass area= (m^2, scalar or per node)")
+            raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: no area given and no graph to "
+                                         "estimate the exposed area from; pass area= (m^2, scalar or per node)")
         a = np.asarray(default_area, dtype=float)[nodes]
     else:
         a = np.asarray(bc.area, dtype=float)
@@ -294,9 +314,10 @@ def _resolve_area(bc, nodes, n, default_area) -> np.ndarray:
         elif a.shape == (n,):
             a = a[nodes]
         else:
-            raise BoundaryConditionError(f"{bc.name!r}: area must be a scalar or an ({n},) array, got {a.shape}")
+            raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: area must be a scalar or an ({n},) "
+                                         f"array, got shape {a.shape}")
     if not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise BoundaryConditionError(f"{bc.name!r}: areas must be finite and >= 0")
+        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: areas must be finite and >= 0 (m^2)")
     return a
 
 
@@ -321,13 +342,20 @@ def stable_time_step(capacity, edges, conductance, h_area=None, fixed=None) -> f
 
 def theta_of(theta) -> float:
     """theta from a number in [0, 1] or a name ('explicit', 'crank-nicolson', 'backward-euler')."""
+    if isinstance(theta, (bool, np.bool_)) or theta is None:
+        raise ValueError(f"theta must be 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1], "
+                         f"got {theta!r}")
     if isinstance(theta, str):
         try:
             return _THETA_NAMES[theta.lower()]
         except KeyError:
             raise ValueError(f"unknown integrator {theta!r}; known: {', '.join(sorted(_THETA_NAMES))} "
                              "or a number in [0, 1]") from None
-    t = float(theta)
+    try:
+        t = float(theta)
+    except (TypeError, ValueError):
+        raise ValueError(f"theta must be a name ({', '.join(sorted(_THETA_NAMES))}) or a number in [0, 1], "
+                         f"got {theta!r}") from None
     if not (0.0 <= t <= 1.0):
         raise ValueError(f"theta must be in [0, 1], got {theta}")
     return t
@@ -389,6 +417,11 @@ class HeatStep:
 class HeatSolver:
     """Lumped heat conduction on a network, advanced step by step with the theta method.
 
+    The structure (the fixed-temperature sets condensed out, the sparsity pattern, the linear
+    solver and its setup) is kept; :meth:`update_values` changes conductances and capacities
+    in place and :meth:`update_edges` takes a new edge set (a subset keeps the structure).
+    Temperatures, time and the energy ledger are owned here and survive both.
+
     Parameters
     ----------
     capacity : (n,) heat capacities C_i [J/K], > 0
@@ -403,13 +436,20 @@ class HeatSolver:
         Fraction of the stability bound used as the largest (sub-)step (default 0.9).
     max_substeps : int
         Refuse (ThermalError) a step that would need more explicit sub-steps than this.
-    solver : linear solver name or object for theta > 0 (default 'direct': sparse LU kept while
-        dt and the network do not change; 'cg' works too, the matrix is SPD)
+    solver : linear solver name or object for theta > 0 (default 'cg': Jacobi-CG on the
+        temperature change of the step, warm-started from the previous change, to a relative
+        residual of 1e-12 of that change; the setup is kept while the structure is;
+        'cg-deflated', 'direct' also work, the matrix is SPD)
     time : initial time [s]
+    energy : dict, optional
+        Energy ledger to continue (see ``energy``), e.g. of a solver this one replaces.
     graph : ContactGraph, optional
         Lets boundary conditions use selectors / graph ids and default exposed areas.
     area : (n,) exposed areas [m^2], optional
         Default areas of Convection/HeatFlux(flux=) (else :func:`exposed_area` of ``graph``).
+    nodes_of : dict name -> node indices, optional
+        Already resolved node sets of the boundary conditions (used instead of their ``nodes``).
+    coords : (n, 3) node positions [m], optional (coarse space of 'cg-deflated')
 
     Notes
     -----
@@ -420,95 +460,92 @@ class HeatSolver:
     as it was.
     """
 
+    RTOL = 1e-12
+
     def __init__(self, capacity, edges, conductance, temperature, *, fixed: Sequence[FixedTemperature] = (),
                  flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), theta="backward-euler",
-                 subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="direct",
-                 time: float = 0.0, graph: Optional[ContactGraph] = None, area=None):
-        C = np.asarray(capacity, dtype=float)
-        if C.ndim != 1 or C.size == 0:
-            raise ValueError(f"capacity must be an (n,) array, got shape {C.shape}")
+                 subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="cg",
+                 time: float = 0.0, energy: Optional[dict] = None, graph: Optional[ContactGraph] = None, area=None,
+                 nodes_of: Optional[dict] = None, coords=None):
+        C = self._check_capacity(capacity)
         n = C.shape[0]
-        _positive("heat capacity", C, n, " (J/K)")
         if graph is not None and graph.n_nodes != n:
             raise ValueError(f"the graph has {graph.n_nodes} nodes, capacity {n}")
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         if edges.size and (edges.min() < 0 or edges.max() >= n):
             raise ValueError(f"edge node index out of range 0..{n - 1}")
-        G = np.asarray(conductance, dtype=float)
-        if G.shape != (edges.shape[0],):
-            raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {G.shape}")
-        if not np.all(np.isfinite(G)) or np.any(G < 0):
-            raise MaterialError("thermal conductances must be finite and >= 0 (W/K); check the conductivity")
         self.theta = theta_of(theta)
         if not (0.0 < safety <= 1.0):
             raise ValueError(f"safety must be in (0, 1], got {safety}")
         self.subcycle, self.safety, self.max_substeps = bool(subcycle), float(safety), int(max_substeps)
-        self.n, self.capacity, self.edges, self.conductance = n, _ro(C), edges, _ro(G)
-        self.graph = graph
+        self.n, self.graph = n, graph
+        self.edges = edges
+        G = self._check_conductance(conductance, edges.shape[0])
         default_area = area if area is not None else (exposed_area(graph) if graph is not None else None)
         if default_area is not None:
             default_area = np.asarray(default_area, dtype=float)
             if default_area.shape != (n,):
                 raise ValueError(f"area must be an ({n},) array, got {default_area.shape}")
 
-        # boundary conditions -> per-node arrays
+        # boundary conditions -> node sets and per-node arrays
         self.fixed_bcs, self.flux_bcs, self.convection_bcs = list(fixed), list(flux), list(convection)
         names = [b.name for b in self.fixed_bcs + self.flux_bcs + self.convection_bcs]
         if len(set(names)) != len(names):
             raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
+        nodes_of = dict(nodes_of or {})
+
+        def nodes(bc):
+            if bc.name in nodes_of:
+                return np.unique(np.asarray(nodes_of[bc.name], dtype=np.int64))
+            return resolve_nodes(bc, n, graph)
         owner = np.full(n, -1, dtype=np.int64)
         self._fixed_nodes = {}
         for k, b in enumerate(self.fixed_bcs):
-            nodes = _resolve_nodes(b, n, graph)
-            clash = nodes[owner[nodes] >= 0]
+            nd = nodes(b)
+            clash = nd[owner[nd] >= 0]
             if clash.size:
                 raise BoundaryConditionError(
-                    f"{clash.size} element(s) are in both fixed-temperature sets "
+                    f"{clash.size} element(s) are in both fixed-temperature boundary conditions "
                     f"{self.fixed_bcs[owner[clash[0]]].name!r} and {b.name!r}; make them disjoint")
-            owner[nodes] = k
-            self._fixed_nodes[b.name] = nodes
+            owner[nd] = k
+            self._fixed_nodes[b.name] = nd
         self._fixed_value = {b.name: float(b.temperature) for b in self.fixed_bcs}
         self.fixed = owner >= 0
         self.fixed.setflags(write=False)
         q = np.zeros(n)
         for b in self.flux_bcs:
-            nodes = _resolve_nodes(b, n, graph)
+            nd = nodes(b)
             if b.power is not None:
                 if b.area is None:
-                    share = np.full(nodes.size, 1.0 / nodes.size)
+                    share = np.full(nd.size, 1.0 / nd.size)
                 else:
-                    a = _resolve_area(b, nodes, n, None)
+                    a = resolve_area(b, nd, n, None)
                     if a.sum() <= 0:
-                        raise BoundaryConditionError(f"heat flux {b.name!r}: the areas sum to 0")
+                        raise BoundaryConditionError(f"heat-flux boundary condition {b.name!r}: the areas sum to 0")
                     share = a / a.sum()
-                np.add.at(q, nodes, b.power * share)
+                np.add.at(q, nd, b.power * share)
             else:
-                np.add.at(q, nodes, b.flux * _resolve_area(b, nodes, n, default_area))
+                np.add.at(q, nd, b.flux * resolve_area(b, nd, n, default_area))
         hA, hAT = np.zeros(n), np.zeros(n)
         for b in self.convection_bcs:
-            nodes = _resolve_nodes(b, n, graph)
-            ha = b.h * _resolve_area(b, nodes, n, default_area)
-            np.add.at(hA, nodes, ha)
-            np.add.at(hAT, nodes, ha * b.t_inf)
+            nd = nodes(b)
+            ha = b.h * resolve_area(b, nd, n, default_area)
+            np.add.at(hA, nd, ha)
+            np.add.at(hAT, nd, ha * b.t_inf)
         hA[self.fixed] = 0.0
         hAT[self.fixed] = 0.0
         q[self.fixed] = 0.0
         self.flux_power, self.h_area, self._hAT = _ro(q), _ro(hA), hAT
+        self.nodes_of = {**self._fixed_nodes,
+                         **{b.name: nodes(b) for b in self.flux_bcs + self.convection_bcs}}
 
-        # matrices, split free (u) / fixed (d)
-        self.K = laplacian(edges, G, n).tocsr()
-        M = (self.K + sp.diags(hA)).tocsr()
-        self._u = np.flatnonzero(~self.fixed)
-        self._d = np.flatnonzero(self.fixed)
-        Mu = M[self._u]
-        self._Muu = Mu[:, self._u].tocsr()
-        self._Mud = Mu[:, self._d].tocsr()
-        self._Kd = self.K[self._d].tocsr()       # heat leaving the fixed nodes
-        self._Cu = C[self._u]
-        self.critical_time_step = stable_time_step(C, edges, G, hA, self.fixed)
-        self._solver = make_solver(solver)
-        self._A = None
-        self._A_key = None
+        self._solver_spec = solver
+        self._coords = None if coords is None else np.asarray(coords, dtype=float)
+        self._solver = None
+        self.structure_builds = 0
+        self.capacity = _ro(C)
+        self.conductance = _ro(G)
+        self._build_structure()
 
         T = np.broadcast_to(np.asarray(temperature, dtype=float), (n,)).copy()
         self._apply_fixed(T)
@@ -520,22 +557,100 @@ class HeatSolver:
         self.steps = 0
         self.substeps = 0
         self.energy = dict(source=0.0, absorbed=0.0, flux=0.0, convection=0.0, boundary=0.0)
+        if energy:
+            self.energy.update({k: float(v) for k, v in energy.items() if k in self.energy})
 
-    # -- construction from a graph ----------------------------------------------------------
-    @classmethod
-    def from_graph(cls, graph: ContactGraph, density, specific_heat, conductivity, temperature, *,
-                   law: str = "continuum", law_params: Optional[dict] = None, volume_fraction=None,
-                   cell_volume=None, **kw) -> "HeatSolver":
-        """A solver on ``graph``: capacities by :func:`heat_capacity`, conductances by
-        :func:`thermal_conductance` with ``law``; other keywords go to the constructor."""
-        C = heat_capacity(graph, density, specific_heat, volume_fraction=volume_fraction, cell_volume=cell_volume)
-        G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
-        return cls(C, graph.edges, G, temperature, graph=graph, **kw)
+    # -- structure and values ---------------------------------------------------------------------
+    @staticmethod
+    def _check_capacity(capacity):
+        C = np.asarray(capacity, dtype=float)
+        if C.ndim != 1 or C.size == 0:
+            raise ValueError(f"capacity must be an (n,) array, got shape {C.shape}")
+        positive_property("heat capacity", C, C.shape[0], " (J/K)")
+        return C
+
+    @staticmethod
+    def _check_conductance(conductance, m):
+        G = np.asarray(conductance, dtype=float)
+        if G.shape != (m,):
+            raise ValueError(f"conductance must have one value per edge ({m}), got {G.shape}")
+        if not np.all(np.isfinite(G)) or np.any(G < 0):
+            raise MaterialError("thermal conductances must be finite and >= 0 (W/K); check the conductivity")
+        return G
+
+    def _build_structure(self):
+        groups = [self._fixed_nodes[b.name] for b in self.fixed_bcs]
+        self.system = ReducedSystem(self.n, self.edges, groups)
+        self._u = self.system.unknown_nodes
+        self._d = np.flatnonzero(self.fixed)
+        nu = self._u.size
+        if self._solver is None or isinstance(self._solver_spec, str):
+            self._solver = make_solver(self._solver_spec, n_unknowns=nu,
+                                       **({"rtol": self.RTOL} if isinstance(self._solver_spec, str)
+                                          and self._solver_spec != "direct" else {}))
+        if self._coords is not None and nu:
+            e = self.edges
+            d = self._coords[e[:, 1]] - self._coords[e[:, 0]]
+            spacing = float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d)))) if e.size else None
+            self._solver.set_geometry(self._coords[self._u], spacing)
+        self._A = None
+        self._A_key = None
+        self._dT_prev = None
+        self.structure_builds += 1
+        self._assemble()
+
+    def _assemble(self):
+        """Fill the kept matrices from the current conductances and capacities."""
+        self.system.assemble(self.conductance, diagonal=self.h_area[self._u])
+        self._Muu, self._Mud = self.system.Kuu, self.system.Kud
+        self._Cu = self.capacity[self._u]
+        M_diag = self.system.unknown_diagonal()
+        sel = M_diag > 0
+        self.critical_time_step = float(np.min(self._Cu[sel] / M_diag[sel])) if np.any(sel) else math.inf
+        self._A_key = None                      # the theta matrix is refilled at the next step
+
+    def update_values(self, conductance=None, capacity=None):
+        """New conductances (same edges) [W/K] and/or capacities [J/K], in place: the structure
+        and the solver setup are kept."""
+        if conductance is not None:
+            self.conductance = _ro(self._check_conductance(conductance, self.edges.shape[0]))
+        if capacity is not None:
+            C = self._check_capacity(capacity)
+            if C.shape != (self.n,):
+                raise ValueError(f"capacity must have {self.n} values, got {C.shape}")
+            self.capacity = _ro(C)
+        self._assemble()
+
+    def update_edges(self, edges, conductance, capacity=None) -> str:
+        """A new edge set: a subset of the current one keeps the structure ('values'), another
+        one rebuilds it ('structure'); temperatures, time and energies are kept."""
+        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        G = self._check_conductance(conductance, edges.shape[0])
+        slots = edge_slots(self.edges, edges, self.n)
+        if slots is not None:
+            full = np.zeros(self.edges.shape[0])
+            full[slots] = G
+            self.update_values(full, capacity)
+            return "values"
+        self.edges = edges
+        self.conductance = _ro(G)
+        if capacity is not None:
+            self.capacity = _ro(self._check_capacity(capacity))
+        self._build_structure()
+        return "structure"
+
+    @property
+    def solver(self):
+        """The linear solver of the implicit steps (kept while the structure is)."""
+        return self._solver
 
     # -- state -----------------------------------------------------------------------------------
     def _apply_fixed(self, T):
         for name, nodes in self._fixed_nodes.items():
             T[nodes] = self._fixed_value[name]
+
+    def _fixed_group_values(self):
+        return np.array([self._fixed_value[b.name] for b in self.fixed_bcs], dtype=float)
 
     @property
     def temperature(self) -> np.ndarray:
@@ -563,6 +678,11 @@ class HeatSolver:
         self._fixed_value[name] = _finite(f"fixed temperature {name!r}", temperature)
         self._T[self._fixed_nodes[name]] = self._fixed_value[name]
 
+    @property
+    def fixed_values(self) -> dict:
+        """Current values of the fixed-temperature sets."""
+        return dict(self._fixed_value)
+
     def heat_content(self, reference) -> float:
         """``sum_i C_i (T_i - reference)`` [J]."""
         return float(np.sum(self.capacity * (self._T - reference)))
@@ -575,9 +695,15 @@ class HeatSolver:
 
     # -- stepping --------------------------------------------------------------------------------
     def _matrix(self, h):
+        """C/h + theta M on the unknowns: one matrix object, refilled in place."""
         key = (h, self.theta)
+        if self._A is None:
+            self._A = self._Muu.copy()
+            self._A_key = None
         if self._A_key != key:
-            self._A = (sp.diags(self._Cu / h) + self.theta * self._Muu).tocsc()
+            self._A.data[:] = self.theta * self._Muu.data
+            self._A.data[self.system.diagonal_slots] += self._Cu / h
+            self._solver.update(self._A)
             self._A_key = key
         return self._A
 
@@ -627,8 +753,8 @@ class HeatSolver:
         h = dt / n_sub
         u, d, th = self._u, self._d, self.theta
         T = self._T.copy()
-        Td = T[d]
-        MudTd = self._Mud @ Td
+        Tg = self._fixed_group_values()
+        MudTd = self._Mud @ Tg if Tg.size else np.zeros(u.size)
         s_u = src[u] + self.flux_power[u] + self._hAT[u]
         Tu = T[u]
         Tu_theta_sum = np.zeros(u.size)
@@ -638,20 +764,34 @@ class HeatSolver:
                 if th == 0.0:
                     Tu_new = Tu + h / self._Cu * (s_u - self._Muu @ Tu - MudTd)
                 else:
-                    rhs = self._Cu / h * Tu - (1.0 - th) * (self._Muu @ Tu) - MudTd + s_u
-                    A = self._matrix(h)
-                    if not np.all(np.isfinite(rhs)):
-                        Tu = rhs
+                    # delta form: (C/h + theta M) dT = s - M T^n - M_ud T_d, so that the solver's
+                    # relative tolerance applies to the change (and the energy balance stays exact)
+                    rhs = s_u - self._Muu @ Tu - MudTd
+                    if not np.all(np.isfinite(rhs)) or not np.isfinite(np.linalg.norm(rhs)):
+                        Tu = np.where(np.isfinite(rhs), np.inf, rhs)    # the step would overflow
                         break
+                    refilled = self._A_key != (h, self.theta)
+                    A = self._matrix(h)
+                    # the rounding level of the right-hand side: no solve can go below it
+                    floor = 1e-13 * (np.linalg.norm(s_u) + np.linalg.norm(self._Muu @ Tu) + np.linalg.norm(MudTd))
+                    x0 = self._dT_prev if self._dT_prev is not None and self._dT_prev.shape == rhs.shape else None
                     try:
-                        Tu_new, sinfo = self._solver.solve(A, rhs, x0=Tu)
-                    except (RuntimeError, ArithmeticError) as exc:
+                        if isinstance(self._solver, _OWN_SOLVERS):
+                            dT, sinfo = self._solver.solve(A, rhs, x0=x0, atol=floor)
+                        else:
+                            dT, sinfo = self._solver.solve(A, rhs, x0=x0)
+                    except (SolverError, RuntimeError, ArithmeticError) as exc:
                         raise ThermalError(
                             f"the linear solve of the theta={th:g} step failed ({exc}); the state is unchanged. "
                             f"With dt = {h:.3g} s, C/dt is {np.min(self._Cu / h):.3g} W/K at the least: on a "
                             "network with no fixed temperature and no convection a step this long leaves the "
                             "matrix numerically singular; take a shorter step") from exc
-                    info.update(sinfo)
+                    info["iterations"] += int(sinfo.get("iterations", 0))
+                    info["solver"] = sinfo.get("solver")
+                    info["setup"] = bool(info.get("setup", False) or sinfo.get("setup", False))
+                    info["update"] = bool(info.get("update", False) or refilled)
+                    self._dT_prev = dT
+                    Tu_new = Tu + dT
                 Tu_theta_sum += th * Tu_new + (1.0 - th) * Tu
                 Tu = Tu_new
                 if not np.all(np.isfinite(Tu)):
@@ -664,10 +804,9 @@ class HeatSolver:
                 "sources and material data, or reduce dt")
         T[u] = Tu
         # energies (exact discrete balance of the theta scheme)
-        Tth = self._T.copy()
-        Tth[u] = Tu_theta_sum / n_sub
-        boundary = dt * float(np.sum(self._Kd @ Tth)) if d.size else 0.0
-        convection = dt * float(np.sum(self._hAT[u] - self.h_area[u] * Tth[u]))
+        Tth_u = Tu_theta_sum / n_sub
+        boundary = dt * float(np.sum(self.system.group_flux(Tth_u, Tg))) if d.size else 0.0
+        convection = dt * float(np.sum(self._hAT[u] - self.h_area[u] * Tth_u))
         step = HeatStep(time=self.time + dt, dt=dt, n_substeps=n_sub,
                         source_energy=dt * float(np.sum(src[u])), absorbed_energy=dt * float(np.sum(src[d])),
                         flux_energy=dt * float(np.sum(self.flux_power[u])), convection_energy=convection,
@@ -698,3 +837,15 @@ class HeatSolver:
         e["convection"] += step.convection_energy
         e["boundary"] += step.boundary_energy
         return step
+
+    # -- construction from a graph ----------------------------------------------------------
+    @classmethod
+    def from_graph(cls, graph: ContactGraph, density, specific_heat, conductivity, temperature, *,
+                   law="continuum", law_params: Optional[dict] = None, volume_fraction=None,
+                   cell_volume=None, **kw) -> "HeatSolver":
+        """A solver on ``graph``: capacities by :func:`heat_capacity`, conductances by
+        :func:`thermal_conductance` with ``law``; other keywords go to the constructor."""
+        C = heat_capacity(graph, density, specific_heat, volume_fraction=volume_fraction, cell_volume=cell_volume)
+        G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
+        kw.setdefault("coords", graph.pos)
+        return cls(C, graph.edges, G, temperature, graph=graph, **kw)

@@ -1,5 +1,5 @@
-"""The electrical engine for ``O.engines``: a ``PyRunner`` that reads the graph (only what
-changed), solves the potentials, writes them back to the bodies and appends a history row.
+"""The engines for ``O.engines``: ``PyRunner``s that read the graph (only what changed), bring
+the kept model up to date, write results back to the bodies and append a history row.
 
 Example (in a YADE script)::
 
@@ -13,57 +13,202 @@ Example (in a YADE script)::
     O.engines = O.engines + [electro.runner]
     O.run(1000, True)
     print(electro.equivalent_resistance, electro.potential_by_id[0])
-    df = electro.history.to_dataframe()
 
 Electrode selectors: YADE predicates (selection by element centre), lists of body ids,
-boolean masks, or callables ``f(pos, radius) -> mask``; ``dict(mask=m)`` selects the
-bodies with ``b.mask & m``.
+boolean masks, or callables ``f(pos, radius) -> mask``; ``dict(mask=m)`` selects the bodies
+with ``b.mask & m``. The elements are selected once, when the engine is built, and kept by
+body id (``reselect=True`` selects again on each new structure).
+
+Everything is checked when the engine is built, in the user's script, with the real
+exception type (YADE reports errors inside ``O.run`` only as ``PyRunner error``).
+
+Save and load: the engine keeps its configuration and state in ``O.tags``
+(:mod:`.persistence`); after ``O.load`` it continues by itself (the saved PyRunner re-attaches
+it), and ``engine = yade_electro.yade.attach(label)`` gives back a handle.
 """
 from __future__ import annotations
 
 import dataclasses
 import logging
+import os
+import warnings
 from typing import Dict, Optional
 
 import numpy as np
 
-from ..engine import ElectricalModel, ElectrodeSpec, History
+from ..coupled import ElectroThermalModel
+from ..electrical import ElectricalModel, ElectrodeSpec
+from ..errors import BoundaryConditionError, ThermalError
+from ..geometry import Shape, as_shape
+from ..history import History
+from ..materials import real_number
+from ..thermal import Convection, FixedTemperature, HeatFlux
+from . import persistence, registry
 from .runtime import import_yade
-from .scene import SceneReader, predicate_selector, write_body_attribute
+from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute
 
-__all__ = ["ElectricalEngine", "ElectroThermalEngine", "ensure_thermal_state", "ENGINES", "get_engine"]
+__all__ = ["ElectricalEngine", "ElectroThermalEngine", "ensure_thermal_state", "engine_class"]
 
 log = logging.getLogger(__name__)
 
-#: Engines by label, so that the PyRunner command (a string YADE evaluates) can reach them.
-ENGINES: Dict[str, "ElectricalEngine"] = {}
-
-
-def get_engine(label: str) -> "ElectricalEngine":
-    """The ElectricalEngine registered under ``label``."""
-    try:
-        return ENGINES[label]
-    except KeyError:
-        raise KeyError(f"no yade-electro engine labelled {label!r}; have {sorted(ENGINES)}") from None
-
 
 def _is_predicate(obj) -> bool:
-    return callable(obj) and hasattr(obj, "aabb") and hasattr(obj, "dim")
+    return callable(obj) and hasattr(obj, "aabb") and hasattr(obj, "dim") and not isinstance(obj, Shape)
 
 
-def _normalise_selector(sel, reader: SceneReader):
-    if _is_predicate(sel):
-        return predicate_selector(sel)
-    if isinstance(sel, dict) and set(sel) == {"mask"}:
-        m = int(sel["mask"])
-
-        def by_mask(pos, radius):
-            return np.array([bool(b.mask & m) for b in reader.bodies])
-        return by_mask
-    return sel
+def _check_period(iterPeriod):
+    if isinstance(iterPeriod, bool) or not isinstance(iterPeriod, (int, np.integer)) or iterPeriod <= 0:
+        raise ValueError(f"iterPeriod must be an integer >= 1 (steps between two calls), got {iterPeriod!r}")
+    return int(iterPeriod)
 
 
-class ElectricalEngine:
+class _Engine:
+    """What both engines share: configuration, scene reader, runner, history, state tags."""
+
+    DEFAULT_LABEL = "electro"
+
+    def _start(self, O, label, resume, iterPeriod, reader_options, history, history_mode, write_back, plot):
+        yade = import_yade()
+        self.O = O if O is not None else yade.Omega()
+        self.removed = False
+        self.error = None
+        self._resume = resume
+        self.label = label if resume is not None else registry.claim_label(label, self.DEFAULT_LABEL, self.O)
+        self.iterPeriod = _check_period(iterPeriod)
+        self.reader = SceneReader(self.O, **reader_options)
+        if history_mode not in ("w", "a", "x"):
+            raise ValueError(f"history_mode must be 'w', 'a' or 'x', got {history_mode!r}")
+        self.history_path = None if history is None else os.fspath(history)
+        self.write_back = write_back
+        if not isinstance(plot, bool):
+            raise ValueError(f"plot must be True or False, got {plot!r}")
+        self.plot = plot
+        self._written = None
+
+    def _normalise_selector(self, sel):
+        if _is_predicate(sel):
+            return predicate_selector(sel)
+        if isinstance(sel, dict) and set(sel) == {"mask"}:
+            m = sel["mask"]
+            if isinstance(m, bool) or not isinstance(m, (int, np.integer)):
+                raise BoundaryConditionError(f"dict(mask=...) needs an integer group mask, got {m!r}")
+            reader = self.reader
+
+            def by_mask(pos, radius):
+                return np.array([bool(b.mask & int(m)) for b in reader.bodies])
+            return by_mask
+        return sel
+
+    def _finish(self, history_mode):
+        """After the model is built: first read, checks, history, runner, saved config."""
+        graph = self.reader.read()                  # no spheres: GraphError here, in the script
+        check_write_back(self.write_back, self.reader.bodies)
+        self._prepare(graph)                        # selections, structure: their errors here too
+        mode = "a" if self._resume is not None else history_mode
+        self.history = History(self.history_path, mode)
+        registry.check_shared_outputs(self)
+        if self._resume is not None:
+            self._restore_history(self._resume_state)
+        yade = import_yade()
+        self.runner = None
+        for e in self.O.engines:                    # a loaded scene keeps its PyRunner
+            if type(e).__name__ == "PyRunner" and e.label == self.label:
+                self.runner = e
+        if self.runner is None:
+            self.runner = yade.PyRunner(
+                command=f"__import__('yade_electro.yade.registry', fromlist=['run']).run({self.label!r})",
+                iterPeriod=self.iterPeriod, label=self.label)
+        registry.ENGINES[self.label] = self
+        self._save_config()
+        self._save_state()
+
+    # -- persistence ---------------------------------------------------------------------------
+    def _save_config(self):
+        kwargs = self._config_kwargs()
+        saved, missing = {}, []
+        import pickle
+        for k, v in kwargs.items():
+            try:
+                pickle.dumps(v, protocol=4)
+                saved[k] = v
+            except Exception:
+                missing.append(k)
+        if missing:
+            log.warning("engine %r: %s cannot be saved with the scene; after O.load, attach(%r, %s=...) must give "
+                        "them again", self.label, ", ".join(missing), self.label, missing[0])
+        persistence.save_config(self.O, self.label, {"engine": type(self).__name__, "version": 1,
+                                                     "kwargs": saved, "missing": missing})
+
+    def _restore_history(self, state):
+        rows = int(state.get("rows", len(self.history))) if state else len(self.history)
+        extra = self.history.truncate(rows)
+        if extra and self.history.path:
+            side = self.history.path + ".after-save.csv"
+            h = History(side, "w")
+            for r in extra:
+                h.append(r)
+            warnings.warn(f"history {self.history.path!r} had {len(extra)} row(s) written after the scene was saved; "
+                          f"they are moved to {side!r} and the run continues from the save", stacklevel=4)
+
+    @property
+    def _resume_state(self):
+        return persistence.load_state(self.O, self.label) or {}
+
+    # -- liveness, removal ---------------------------------------------------------------------
+    @property
+    def live(self) -> bool:
+        """Registered, not removed, and its scene is the current one."""
+        return not self.removed and not self.reader.scene_replaced
+
+    @property
+    def written_attributes(self) -> tuple:
+        return (self.write_back,) if self.write_back else ()
+
+    def remove(self):
+        """Take the engine out of ``O.engines``, the registry and the scene's tags."""
+        self.O.engines = [e for e in self.O.engines if e is not self.runner]
+        if registry.ENGINES.get(self.label) is self:
+            registry.ENGINES.pop(self.label, None)
+        persistence.forget(self.O, self.label)
+        self.removed = True
+
+    def _reattach_in_place(self):
+        """The scene was replaced (``O.load`` in this process): continue from what it saved."""
+        config = persistence.load_config(self.O, self.label)
+        if config is None:
+            raise RuntimeError(f"engine {self.label!r}: the scene it ran on was replaced (O.load of another scene, or "
+                               "O.reset) and the new one holds no saved engine of that label; build a new engine")
+        log.warning("engine %r: the scene was replaced (O.load): continuing from the state it saved", self.label)
+        kwargs = dict(config["kwargs"])
+        registry.ENGINES.pop(self.label, None)
+        type(self).__init__(self, **kwargs, label=self.label, O=self.O, _resume=config)
+
+    # -- one call ------------------------------------------------------------------------------
+    def step(self):
+        """One call on the current scene (what the PyRunner calls)."""
+        try:
+            if self.removed:
+                raise RuntimeError(f"engine {self.label!r} was removed")
+            if self.reader.scene_replaced:
+                self._reattach_in_place()
+            out = self._step()
+        except Exception as exc:
+            self.error = exc
+            log.error("yade-electro engine %r failed at iteration %d: %s: %s", self.label, int(self.O.iter),
+                      type(exc).__name__, exc)
+            raise
+        self._save_state()
+        return out
+
+    def _write_row(self, row):
+        self.history.append(row)
+        if self.plot:
+            from yade import plot
+            plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
+
+
+# =========================================================================================
+class ElectricalEngine(_Engine):
     """Electrical conduction solved every ``iterPeriod`` steps of a YADE simulation.
 
     Parameters
@@ -71,77 +216,115 @@ class ElectricalEngine:
     resistivity : float
         rho_e [ohm m].
     electrodes : dict name -> dict(select=..., potential=V | current=A)
-    law, law_params, solver, measure : see ``yade_electro.engine.ElectricalModel``
-    iterPeriod : int
-        Steps between two solves (the PyRunner's period).
+    law, law_params, solver, measure, reselect : see ``yade_electro.electrical.ElectricalModel``
+        (a YADE predicate as ``law_params['container']`` is converted to a shape)
+    iterPeriod : int >= 1
+        Steps between two calls (the PyRunner's period).
     history : str, optional
         CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
-    bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check : see ``SceneReader``
+    history_mode : {'w', 'a', 'x'}
+        Replace (saying so), append to, or refuse an existing file.
+    bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check, sweep_calls :
+        see :class:`~yade_electro.yade.scene.SceneReader`
     write_back : str or None
         Body attribute that receives each element's potential [V] (default 'potential');
-        None to skip.
+        None to skip. YADE's own attributes are refused.
     plot : bool
         Also feed ``yade.plot.addData`` with the history row.
-    label : str
-        Label of the PyRunner and key in ``ENGINES``.
+    label : str, optional
+        Label of the PyRunner and key in the registry (default 'electro', numbered if taken).
     """
 
-    def __init__(self, resistivity, electrodes, law="continuum", law_params=None, solver="cg",
-                 measure=None, iterPeriod: int = 1, history: Optional[str] = None, bonds="cohesive",
-                 mask=None, geometry_every: int = 1, move_tolerance: float = 1e-4, full_read_every: int = 0,
-                 bond_check: str = "flags", write_back: Optional[str] = "potential", plot: bool = False, label: str = "electro",
-                 O=None):
-        yade = import_yade()
-        self.O = O if O is not None else yade.Omega()
-        self.reader = SceneReader(self.O, bonds=bonds, mask=mask, geometry_every=geometry_every,
-                                  move_tolerance=move_tolerance, full_read_every=full_read_every,
-                                  bond_check=bond_check)
+    DEFAULT_LABEL = "electro"
+
+    def __init__(self, resistivity=None, electrodes=None, law="continuum", law_params=None, solver="auto",
+                 measure=None, iterPeriod: int = 1, history: Optional[str] = None, history_mode: str = "w",
+                 bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
+                 full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
+                 write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
+                 reselect: bool = False, O=None, _resume=None):
+        reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
+        self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
+        self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
+        self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
+        self._finish(history_mode)
+
+    def _make_electrical(self, resistivity, electrodes, law, law_params, solver, measure, reselect):
+        if resistivity is None:
+            raise ValueError("give resistivity= (ohm m)")
+        if electrodes is None or not isinstance(electrodes, dict) or not electrodes:
+            raise BoundaryConditionError("give electrodes={name: dict(select=..., potential=V | current=A)}")
         law_params = dict(law_params or {})
-        if _is_predicate(law_params.get("container")):
-            # the voronoi law needs a signed distance: convert YADE's predicate
-            from .packing import as_shape
+        if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
             law_params["container"] = as_shape(law_params["container"])
+        self._law_params = law_params
         specs = []
-        for name, spec in dict(electrodes).items():
+        for name, spec in electrodes.items():
+            if not isinstance(spec, dict):
+                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=..., potential=...|current=...)")
             spec = dict(spec)
-            spec["select"] = _normalise_selector(spec.get("select"), self.reader)
+            spec["select"] = self._normalise_selector(spec.get("select"))
+            unknown = set(spec) - {"select", "potential", "current"}
+            if unknown:
+                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}")
             specs.append(ElectrodeSpec(name, **spec))
-        self.model = ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver,
-                                     measure=measure)
-        self.history = History(history)
-        self.write_back = write_back
-        self.plot = plot
-        self.label = label
-        self.values: Dict[str, float] = {}
-        ENGINES[label] = self
-        # fail in the user's script, with the real exception type, rather than later inside
-        # O.run() where YADE reports every PyRunner failure as "RuntimeError: PyRunner error."
-        if any(b is not None and isinstance(b.shape, yade.Sphere) for b in self.O.bodies):
-            self.model.prepare(self.reader.read())
-        self.runner = yade.PyRunner(
-            command=f"__import__('yade_electro.yade.engines', fromlist=['get_engine']).get_engine({label!r}).step()",
-            iterPeriod=int(iterPeriod), label=label)
+        self._resistivity = resistivity
+        return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
+                               reselect=reselect)
+
+    # -- persistence ---------------------------------------------------------------------------
+    def _electrode_config(self):
+        out = {}
+        for s in self.model.specs:
+            ids = self.model.memberships[s.name].ids
+            out[s.name] = dict(select=np.asarray(ids, dtype=np.int64), **(
+                {"potential": s.potential} if s.fixed else {"current": s.current}))
+        return out
+
+    def _law_config(self):
+        params = dict(self._law_params)
+        ref = getattr(self.model.law, "reference", None)
+        if ref is not None:
+            params["reference"] = ref
+        return params
+
+    def _config_kwargs(self):
+        o = self._options
+        return dict(resistivity=self._resistivity, electrodes=self._electrode_config(), law=o["law"],
+                    law_params=self._law_config(), solver=o["solver"] if isinstance(o["solver"], str) else "auto",
+                    measure=o["measure"], iterPeriod=self.iterPeriod, history=self.history_path,
+                    bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
+                    move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
+                    bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
+                    plot=self.plot, reselect=o["reselect"])
+
+    def _save_state(self):
+        persistence.save_state(self.O, self.label, {
+            "iter": int(self.O.iter), "time": float(self.O.time), "values": dict(self.model.values),
+            "rows": len(self.history)})
+
+    def _prepare(self, graph):
+        if self._resume is not None:
+            for k, v in (self._resume_state.get("values") or {}).items():
+                self.model.set_electrode(k, v)
+        self.model.update(graph)
 
     # -- stepping ------------------------------------------------------------------------
     def set_electrode(self, name: str, value: float):
-        """Change an electrode's potential [V] or current [A] from the next solve on."""
-        if name not in [s.name for s in self.model.specs]:
-            raise KeyError(f"no electrode {name!r}")
-        self.values[name] = float(value)
+        """Change an electrode's potential [V] or current [A] from the next call on."""
+        self.model.set_electrode(name, value)
 
-    def step(self):
-        """One solve on the current scene (what the PyRunner calls)."""
+    def _step(self):
         graph = self.reader.read()
-        sol = self.model.solve(graph, self.values or None)
-        if self.write_back:
+        sol = self.model.solve(graph)
+        if self.write_back and sol is not self._written:
             write_body_attribute(self.reader.bodies, self.write_back, sol.potential)
+            self._written = sol
         row = {"iter": int(self.O.iter), "time": float(self.O.time)}
         row.update(self.model.summary())
         row["graph_revision"] = int(graph.revision)
-        self.history.append(row)
-        if self.plot:
-            from yade import plot
-            plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
+        self._write_row(row)
         return sol
 
     # -- results -------------------------------------------------------------------------
@@ -161,12 +344,12 @@ class ElectricalEngine:
 
     @property
     def equivalent_resistance(self) -> float:
-        """R_eq [ohm] between the ``measure`` electrodes at the last solve."""
+        """R_eq [ohm] between the ``measure`` electrodes at the last solve (network property)."""
         return self.model.equivalent_resistance
 
     @property
     def body_ids(self) -> np.ndarray:
-        return self.graph.ids
+        return self.model.bond_graph.ids
 
     @property
     def potential(self) -> np.ndarray:
@@ -175,21 +358,19 @@ class ElectricalEngine:
 
     @property
     def potential_by_id(self) -> Dict[int, float]:
-        return dict(zip(self.graph.ids.tolist(), self.solution.potential.tolist()))
+        return dict(zip(self.body_ids.tolist(), self.solution.potential.tolist()))
 
     @property
     def branch_currents(self):
-        """(id pairs (m, 2), current (m,) [A] flowing from the first body to the second)."""
-        return self.graph.ids[self.graph.edges], self.solution.branch_current
+        """(id pairs (m, 2), current (m,) [A] flowing from the first body to the second), over
+        the edges that conduct."""
+        c = self.model.conductance
+        keep = c > 0
+        return self.body_ids[self.model.network_edges[keep]], self.solution.branch_current[keep]
 
     @property
     def electrode_currents(self) -> Dict[str, float]:
         return dict(self.solution.electrode_current)
-
-    def remove(self):
-        """Take the engine out of ``O.engines`` and the registry."""
-        self.O.engines = [e for e in self.O.engines if e is not self.runner]
-        ENGINES.pop(self.label, None)
 
 
 def ensure_thermal_state(bodies) -> int:
@@ -207,25 +388,27 @@ def ensure_thermal_state(bodies) -> int:
     return replaced
 
 
+# =========================================================================================
 class ElectroThermalEngine(ElectricalEngine):
     """Joule heating and heat conduction every ``iterPeriod`` steps of a YADE simulation.
 
-    Each call reads the graph (only what changed), solves the potential (again only when the
-    graph, rho_e(T) or an electrode value changed), computes the Joule heat, advances the
-    temperatures by the thermal time step and writes them to ``b.state.temp`` (a
-    ``ThermalState`` is given to bodies that do not have one), and the potential to
-    ``b.potential``. One history row per call is written to the CSV as the run goes.
+    Each call reads the graph (only what changed), brings the potential up to date (a solve
+    only when the geometry, rho_e(T) or the structure changed), computes the Joule heat,
+    advances the temperatures by the thermal step and writes them to ``b.state.temp`` (a
+    ``ThermalState`` is given to bodies that do not have one) and the potential to
+    ``b.potential``. One history row per call goes to the CSV as the run goes.
 
     Thermal time: by default each call advances by the simulated time elapsed since the
-    previous call (``O.time`` difference) times ``time_scale``; give ``thermal_dt`` to
-    advance by a fixed thermal step per call instead (the heat and mechanics then run on
-    separate clocks). Either way the integrator sub-cycles (explicit) or takes the step in
-    one implicit solve (theta method), so it is never bound to ``O.dt``.
+    previous call (``O.time`` difference) times ``time_scale``; give ``thermal_dt`` to advance
+    by a fixed thermal step per call instead (the heat and mechanics then run on separate
+    clocks). Either way the integrator sub-cycles (explicit) or takes the step in one implicit
+    solve (theta method), so it is never bound to ``O.dt``.
 
     Parameters
     ----------
     resistivity, electrodes, law, law_params, solver, measure, iterPeriod, history, bonds,
-    mask, geometry_every, move_tolerance, full_read_every, plot, label : see ElectricalEngine
+    mask, geometry_every, move_tolerance, full_read_every, bond_check, plot, label : see ElectricalEngine
+        ``electrodes=None``: heat conduction only (no resistivity needed).
     density [kg/m^3], specific_heat [J/(kg K)], conductivity [W/(m K)] : thermal material
     temperature : initial temperature [K]
     beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
@@ -233,47 +416,140 @@ class ElectroThermalEngine(ElectricalEngine):
     fixed, flux, convection : lists of ``yade_electro.thermal`` FixedTemperature, HeatFlux,
         Convection; their ``nodes`` may be YADE predicates, body id lists or masks
     thermal_dt : float, optional; time_scale : float
+    thermal_solver : linear solver of the implicit heat step ('cg' default)
     coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
     """
 
-    def __init__(self, resistivity, electrodes, density, specific_heat, conductivity, temperature,
-                 beta=0.0, eta=1.0, theta="backward-euler", fixed=(), flux=(), convection=(),
-                 thermal_dt=None, time_scale=1.0, coupled_options=None, label="electrothermal", **kw):
-        from ..coupled import ElectroThermalModel
-        self._thermal_setup = None
-        super().__init__(resistivity, electrodes, label=label, **kw)
-        bcs = []
-        for group in (fixed, flux, convection):
-            out = []
-            for bc in group:
-                out.append(dataclasses.replace(bc, nodes=_normalise_selector(bc.nodes, self.reader)))
-            bcs.append(out)
-        if thermal_dt is not None and not (thermal_dt > 0):
-            raise ValueError(f"thermal_dt must be > 0 (s), got {thermal_dt}")
-        if not (time_scale > 0):
+    DEFAULT_LABEL = "electrothermal"
+
+    def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
+                 temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(), flux=(), convection=(),
+                 thermal_dt=None, time_scale=1.0, thermal_solver="cg", coupled_options=None, law="continuum",
+                 law_params=None, solver="auto", measure=None, iterPeriod: int = 1, history: Optional[str] = None,
+                 history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
+                 move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
+                 sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
+                 label: Optional[str] = None, reselect: bool = False, O=None, _resume=None):
+        reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
+        self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
+                    write_back if electrodes is not None else None, plot)
+        self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
+        if temperature is None:
+            raise ValueError("give the initial temperature= (K)")
+        if electrodes is not None:
+            self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
+        else:
+            self.model = None
+            self._law_params = dict(law_params or {})
+            if self._law_params.get("container") is not None and not isinstance(self._law_params["container"], Shape):
+                self._law_params["container"] = as_shape(self._law_params["container"])
+            self._resistivity = resistivity
+        if thermal_dt is not None:
+            thermal_dt = real_number("thermal_dt (s)", thermal_dt)
+            if not thermal_dt > 0:
+                raise ValueError(f"thermal_dt must be > 0 (s), got {thermal_dt}")
+        time_scale = real_number("time_scale", time_scale)
+        if not time_scale > 0:
             raise ValueError(f"time_scale must be > 0, got {time_scale}")
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
-        self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature,
-                                           beta=beta, eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1],
-                                           convection=bcs[2], **(coupled_options or {}))
+        bcs = []
+        for group, cls in ((fixed, FixedTemperature), (flux, HeatFlux), (convection, Convection)):
+            out = []
+            for bc in group:
+                if not isinstance(bc, cls):
+                    raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.thermal), got {bc!r}")
+                out.append(dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
+            bcs.append(out)
+        self._thermal = dict(density=density, specific_heat=specific_heat, conductivity=conductivity,
+                             temperature=temperature, beta=beta, eta=eta, theta=theta, thermal_dt=thermal_dt,
+                             time_scale=time_scale, thermal_solver=thermal_solver,
+                             coupled_options=dict(coupled_options or {}))
+        extra = dict(coupled_options or {})
+        if self.model is None:
+            extra.setdefault("law", law)
+            extra.setdefault("law_params", self._law_params)
+        self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
+                                           eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
+                                           thermal_solver=thermal_solver, **extra)
         self._last_time = float(self.O.time)
         self._states_checked = -1
+        if _resume is not None:
+            st = self._resume_state
+            self._last_time = float(st.get("mech_time", self._last_time))
+            self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
+            self.coupled.restore_temperatures(self._read_temperatures)
+        self._finish(history_mode)
 
-    def step(self):
-        """One coupled step on the current scene (what the PyRunner calls)."""
+    def _read_temperatures(self, graph):
+        yade = import_yade()
+        bodies = self.reader.bodies
+        if not all(isinstance(b.state, yade.ThermalState) for b in bodies):
+            raise ThermalError(f"engine {self.label!r}: the loaded bodies have no ThermalState, so their temperatures "
+                               "were not saved; cannot continue the thermal run")
+        return np.array([b.state.temp for b in bodies], dtype=float)
+
+    # -- persistence ---------------------------------------------------------------------------
+    def _config_kwargs(self):
+        if self.model is not None:
+            kw = super()._config_kwargs()
+        else:
+            o = self._options
+            kw = dict(resistivity=self._resistivity, electrodes=None, law=o["law"], law_params=self._law_params,
+                      solver="auto", measure=None, iterPeriod=self.iterPeriod, history=self.history_path,
+                      bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
+                      move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
+                      bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=None, plot=self.plot,
+                      reselect=o["reselect"])
+        t = dict(self._thermal)
+        bcs = {}
+        for group in ("fixed", "flux", "convection"):
+            out = []
+            for bc in getattr(self.coupled, group):
+                ids = self.coupled.bc_memberships[bc.name].ids
+                out.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
+            bcs[group] = out
+        kw.update(t)
+        kw.update(bcs)
+        return kw
+
+    def _save_state(self):
+        heat = self.coupled.heat
+        persistence.save_state(self.O, self.label, {
+            "iter": int(self.O.iter), "time": float(self.O.time), "mech_time": self._last_time,
+            "values": dict(self.model.values) if self.model is not None else {},
+            "thermal_time": self.coupled.time, "energy": dict(heat.energy) if heat is not None else {},
+            "fixed_values": heat.fixed_values if heat is not None else {},
+            "rows": len(self.history)})
+
+    def _prepare(self, graph):
+        if self._resume is not None and self.model is not None:
+            for k, v in (self._resume_state.get("values") or {}).items():
+                self.model.set_electrode(k, v)
+        self.coupled.refresh(graph)
+        if self._resume is not None:
+            for k, v in (self._resume_state.get("fixed_values") or {}).items():
+                self.coupled.heat.set_fixed_temperature(k, v)
+
+    def set_fixed_temperature(self, name: str, temperature: float):
+        """Change a fixed-temperature boundary condition's value from the next call on."""
+        self.coupled.heat.set_fixed_temperature(name, temperature)
+
+    @property
+    def written_attributes(self) -> tuple:
+        return super().written_attributes + ("state.temp",)
+
+    # -- stepping ------------------------------------------------------------------------
+    def _step(self):
         graph = self.reader.read()
         if self.thermal_dt is not None:
             dt = self.thermal_dt
         else:
             dt = (float(self.O.time) - self._last_time) * self.time_scale
         if dt <= 0:             # first call at the start of a run: nothing to integrate yet
-            dt = None
-        if dt is None:
-            self.coupled._prepare(graph)
-            self.coupled._solve_potential(graph)
-            row = self.coupled.summary()
+            row = self.coupled.refresh(graph)
         else:
-            row = self.coupled.step(graph, dt, self.values or None)
+            row = self.coupled.step(graph, dt)
         self._last_time = float(self.O.time)
         bodies = self.reader.bodies
         if self._states_checked != self.reader.full_reads:    # the body set changes only there
@@ -281,18 +557,34 @@ class ElectroThermalEngine(ElectricalEngine):
             self._states_checked = self.reader.full_reads
         for b, t in zip(bodies, self.coupled.temperature.tolist()):
             b.state.temp = t
-        if self.write_back:
-            write_body_attribute(bodies, self.write_back, self.model.solution.potential)
+        sol = self.coupled.solution
+        if self.write_back and sol is not None and sol is not self._written:
+            write_body_attribute(bodies, self.write_back, sol.potential)
+            self._written = sol
         out = {"iter": int(self.O.iter), "mech_time": float(self.O.time)}
         out.update(row)
         out["graph_revision"] = int(graph.revision)
-        self.history.append(out)
-        if self.plot:
-            from yade import plot
-            plot.addData(**{f"electro_{k}": v for k, v in out.items()})
+        self._write_row(out)
         return out
 
     @property
     def temperature(self) -> np.ndarray:
         """Temperature [K] of each element, in ``body_ids`` order."""
         return self.coupled.temperature
+
+    @property
+    def body_ids(self) -> np.ndarray:
+        return self.coupled.network.graph.ids
+
+    @property
+    def temperature_by_id(self) -> Dict[int, float]:
+        return dict(zip(self.body_ids.tolist(), self.coupled.temperature.tolist()))
+
+
+def engine_class(name: str):
+    """The engine class of a saved configuration."""
+    classes = {"ElectricalEngine": ElectricalEngine, "ElectroThermalEngine": ElectroThermalEngine}
+    try:
+        return classes[name]
+    except KeyError:
+        raise KeyError(f"unknown saved engine type {name!r}") from None

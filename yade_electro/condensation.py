@@ -1,0 +1,164 @@
+"""Dirichlet condensation of a network Laplacian, kept as a structure whose values are updated
+in place: the one condensation the electrical and the thermal problems share.
+
+The network: ``n`` nodes, ``m`` edges with values ``c`` (conductances [S] or [W/K]); its
+Laplacian is ``K = A^T diag(c) A`` (A the incidence matrix). Some node sets are *groups*: the
+nodes of a group are tied together (a perfect conductor, one value for all of them, e.g. an
+electrode or a fixed-temperature set) and the group's value is imposed (Dirichlet). Nodes
+may also be *excluded* (floating clusters: value 0, not solved for). What is left are the
+unknowns ``u``, and
+
+    K_uu x_u = f_u - K_ud x_d,        net flux leaving group g:  (K_dd x_d + K_du x_u)_g
+
+:class:`ReducedSystem` computes, once per structure, the sparsity patterns of ``K_uu``
+(with an explicit diagonal for every unknown), ``K_ud`` and ``K_dd`` and the linear maps from
+the edge values to their CSR data. :meth:`ReducedSystem.assemble` then fills the data of the
+*same* matrix objects from new edge values (one sparse mat-vec each), so that solvers keep
+their setup (see :mod:`yade_electro.solvers`) and a change of values never rebuilds structure.
+"""
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["ReducedSystem"]
+
+
+def _pattern(rows, cols, shape):
+    """A CSR matrix (zero data) with one entry per distinct (row, col) and, for every input
+    pair, the index of its entry in ``data``."""
+    nr, nc = shape
+    key = rows.astype(np.int64) * nc + cols.astype(np.int64)
+    ukey, slot = np.unique(key, return_inverse=True)
+    indptr = np.searchsorted(ukey // nc, np.arange(nr + 1)) if nc else np.zeros(nr + 1, dtype=np.int64)
+    M = sp.csr_matrix((np.zeros(ukey.size), (ukey % nc).astype(np.int32) if nc else ukey.astype(np.int32),
+                       indptr), shape=shape)
+    return M, slot.reshape(-1)
+
+
+def _map(slots, edge, sign, nnz, m):
+    """Sparse (nnz x m) matrix taking edge values to CSR data."""
+    return sp.csr_matrix((sign, (slots, edge)), shape=(nnz, m))
+
+
+class ReducedSystem:
+    """Structure of a network Laplacian condensed on Dirichlet groups.
+
+    Parameters
+    ----------
+    n_nodes : int
+    edges : (m, 2) int array of node indices
+    groups : sequence of int arrays
+        Disjoint node sets, each one Dirichlet super-node (order kept: group g is column g
+        of ``K_ud``).
+    exclude : (n,) bool array, optional
+        Nodes left out (they must not share an edge of non-zero value with kept nodes).
+
+    Attributes
+    ----------
+    unknown_nodes : (nu,) node index of every unknown, in unknown order
+    unknown_index : (n,) unknown index of every node (-1 for group and excluded nodes)
+    group_of : (n,) group of every node (-1 elsewhere)
+    Kuu, Kud, Kdd : CSR matrices (nu x nu, nu x ng, ng x ng) filled by :meth:`assemble`
+    diagonal_slots : (nu,) index of each unknown's diagonal entry in ``Kuu.data``
+    """
+
+    def __init__(self, n_nodes: int, edges, groups: Sequence = (), exclude: Optional[np.ndarray] = None):
+        n = int(n_nodes)
+        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        m = edges.shape[0]
+        ng = len(groups)
+        group_of = np.full(n, -1, dtype=np.int64)
+        for g, nodes in enumerate(groups):
+            nodes = np.asarray(nodes, dtype=np.int64)
+            if np.any(group_of[nodes] >= 0):
+                raise ValueError("groups of a ReducedSystem must be disjoint")
+            group_of[nodes] = g
+        excluded = np.zeros(n, bool) if exclude is None else np.asarray(exclude, bool).copy()
+        excluded &= group_of < 0
+        unknown = (group_of < 0) & ~excluded
+        unknown_nodes = np.flatnonzero(unknown)
+        nu = unknown_nodes.size
+        uidx = np.full(n, -1, dtype=np.int64)
+        uidx[unknown_nodes] = np.arange(nu)
+        self.n, self.m, self.n_groups, self.n_unknowns = n, m, ng, nu
+        self.edges, self.group_of, self.excluded = edges, group_of, excluded
+        self.unknown_nodes, self.unknown_index = unknown_nodes, uidx
+
+        i, j = edges[:, 0], edges[:, 1]
+        ui, uj, gi, gj = uidx[i], uidx[j], group_of[i], group_of[j]
+        eid = np.arange(m)
+        uu = (ui >= 0) & (uj >= 0)
+        ud_i = (ui >= 0) & (gj >= 0)          # i unknown, j in a group
+        ud_j = (uj >= 0) & (gi >= 0)
+        dd = (gi >= 0) & (gj >= 0) & (gi != gj)
+        self.dropped = ~(uu | ud_i | ud_j | dd)   # same group, or touching an excluded node
+
+        # K_uu: off-diagonals of unknown-unknown edges, the diagonal of every unknown
+        rows = np.concatenate([ui[uu], uj[uu], np.arange(nu)])
+        cols = np.concatenate([uj[uu], ui[uu], np.arange(nu)])
+        self.Kuu, slot = _pattern(rows, cols, (nu, nu))
+        nuu = int(uu.sum())
+        off1, off2, dslot = slot[:nuu], slot[nuu:2 * nuu], slot[2 * nuu:]
+        self.diagonal_slots = dslot
+        e_uu = eid[uu]
+        s_list = [off1, off2, dslot[ui[uu]], dslot[uj[uu]], dslot[ui[ud_i]], dslot[uj[ud_j]]]
+        e_list = [e_uu, e_uu, e_uu, e_uu, eid[ud_i], eid[ud_j]]
+        v_list = [-np.ones(nuu), -np.ones(nuu), np.ones(nuu), np.ones(nuu),
+                  np.ones(int(ud_i.sum())), np.ones(int(ud_j.sum()))]
+        self._uu_map = _map(np.concatenate(s_list), np.concatenate(e_list), np.concatenate(v_list),
+                            self.Kuu.nnz, m)
+
+        # K_ud: -c between an unknown and a group
+        rows = np.concatenate([ui[ud_i], uj[ud_j]])
+        cols = np.concatenate([gj[ud_i], gi[ud_j]])
+        self.Kud, slot = _pattern(rows, cols, (nu, ng))
+        self._ud_map = _map(slot, np.concatenate([eid[ud_i], eid[ud_j]]), -np.ones(slot.size), self.Kud.nnz, m)
+
+        # K_dd: group-group couplings and the group diagonals
+        rows = np.concatenate([gi[dd], gj[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
+        cols = np.concatenate([gj[dd], gi[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
+        self.Kdd, slot = _pattern(rows, cols, (ng, ng))
+        ndd = int(dd.sum())
+        e_dd = eid[dd]
+        edge_of = np.concatenate([e_dd, e_dd, e_dd, e_dd, eid[ud_i], eid[ud_j]])
+        sign = np.concatenate([-np.ones(2 * ndd), np.ones(2 * ndd + int(ud_i.sum()) + int(ud_j.sum()))])
+        self._dd_map = _map(slot[:edge_of.size], edge_of, sign, self.Kdd.nnz, m)
+        self.Kdu = None
+
+    # -- values ------------------------------------------------------------------------------
+    def assemble(self, values, diagonal=None):
+        """Fill ``Kuu``, ``Kud``, ``Kdd`` (the same objects) from edge ``values`` (m,), plus an
+        optional extra diagonal (nu,) on the unknowns (e.g. ``h A`` or ``C / dt``). Returns
+        ``(Kuu, Kud)``."""
+        c = np.asarray(values, dtype=float)
+        self.Kuu.data[:] = self._uu_map @ c
+        if diagonal is not None:
+            self.Kuu.data[self.diagonal_slots] += diagonal
+        self.Kud.data[:] = self._ud_map @ c
+        self.Kdd.data[:] = self._dd_map @ c
+        self.Kdu = self.Kud.T.tocsr()
+        return self.Kuu, self.Kud
+
+    def unknown_diagonal(self) -> np.ndarray:
+        """The diagonal of ``Kuu`` (nu,) as last assembled."""
+        return self.Kuu.data[self.diagonal_slots].copy()
+
+    # -- results -----------------------------------------------------------------------------
+    def expand(self, x_unknown, x_group) -> np.ndarray:
+        """Node values (n,) from the unknowns' and the groups' values (excluded nodes: 0)."""
+        x = np.zeros(self.n)
+        x[self.unknown_nodes] = x_unknown
+        ing = self.group_of >= 0
+        if np.any(ing):
+            x[ing] = np.asarray(x_group, dtype=float)[self.group_of[ing]]
+        return x
+
+    def group_flux(self, x_unknown, x_group) -> np.ndarray:
+        """Net flux leaving each group into the network, ``K_dd x_d + K_du x_u`` (ng,)."""
+        out = self.Kdd @ np.asarray(x_group, dtype=float)
+        if self.n_unknowns and self.Kdu is not None:
+            out = out + self.Kdu @ np.asarray(x_unknown, dtype=float)
+        return out

@@ -1,0 +1,308 @@
+"""The electrical model of a packing, independent of YADE: electrodes chosen once by selector
+and kept by element id, a conductance law, a kept Kirchhoff problem, results.
+
+``ElectricalModel.solve(graph)`` is the one call an engine makes each period. It compares the
+graph with the previous one and does the least work (see :meth:`ElectricalModel.update`):
+
+* same graph object, same resistivity: nothing (the last solution is returned);
+* moved elements (same bonds): new geometric factors, conductances updated in place, the
+  solver setup kept, a warm re-solve;
+* new resistivity (rho_e(T)): conductances updated in place, warm re-solve;
+* broken bonds: the law's new network; when it is a subset of the kept one (the usual case)
+  the structure stays and the lost edges get conductance 0, the connected parts are checked
+  again; otherwise the structure is rebuilt;
+* another element set (bodies added or erased): everything is rebuilt, electrode membership
+  carried over by id.
+
+The model owns the electrode values (:meth:`set_electrode`); changing one never re-solves.
+
+Units: SI (ohm m, V, A, ohm, W, s).
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Dict, List, Mapping, Optional, Sequence
+
+import numpy as np
+
+from .conductance import ConductanceLaw, FactorNetwork, make_law
+from .errors import BoundaryConditionError
+from .graph import ContactGraph
+from .materials import Material, edge_resistivity, positive_property
+from .network import ConductionProblem, Electrode, PotentialSolution, electrode_value
+from .selection import Membership, Selector, check_selector, select_nodes
+from .solvers import check_solver_name
+
+__all__ = ["ElectrodeSpec", "ElectricalModel", "select_nodes", "electrode_specs"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ElectrodeSpec:
+    """An electrode to be resolved on a graph: a selector plus a fixed potential [V] or an
+    imposed current [A] (exactly one), checked at construction."""
+
+    name: str
+    select: Selector
+    potential: Optional[float] = None
+    current: Optional[float] = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise BoundaryConditionError(f"electrode names must be non-empty strings, got {self.name!r}")
+        check_selector(self.select, f"electrode {self.name!r}: select")
+        if (self.potential is None) == (self.current is None):
+            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
+                                         "(fixed potential, V) or current= (imposed current, A)")
+        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
+        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
+
+    @property
+    def fixed(self) -> bool:
+        return self.potential is not None
+
+    @property
+    def value(self) -> float:
+        return float(self.potential if self.fixed else self.current)
+
+    def resolve(self, graph: ContactGraph) -> Electrode:
+        return Electrode(self.name, select_nodes(graph, self.select, self.name, "electrode"), self.potential,
+                         self.current)
+
+
+def electrode_specs(electrodes) -> List[ElectrodeSpec]:
+    """ElectrodeSpecs from a mapping name -> dict(select=..., potential=|current=) or specs."""
+    if isinstance(electrodes, Mapping):
+        out = []
+        for name, spec in electrodes.items():
+            if isinstance(spec, ElectrodeSpec):
+                out.append(spec)
+            elif isinstance(spec, Mapping):
+                unknown = set(spec) - {"select", "potential", "current"}
+                if unknown:
+                    raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give "
+                                                 "select=, and potential= (V) or current= (A)")
+                if "select" not in spec:
+                    raise BoundaryConditionError(f"electrode {name!r}: give select= (a predicate, ids or a mask)")
+                out.append(ElectrodeSpec(name, **spec))
+            else:
+                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=..., potential=...|current=...)")
+        return out
+    if electrodes is None:
+        return []
+    out = list(electrodes)
+    for s in out:
+        if not isinstance(s, ElectrodeSpec):
+            raise BoundaryConditionError(f"electrodes must be a dict name -> dict(select=..., potential=...) or "
+                                         f"ElectrodeSpecs, got {s!r}")
+    return out
+
+
+class ElectricalModel:
+    """Electrical conduction of a packing, solved on demand on the current graph.
+
+    Parameters
+    ----------
+    resistivity : float or (n,) array, or Material
+        Electrical resistivity rho_e [ohm m], > 0 (304L steel: 0.73e-6), or a Material.
+    electrodes : mapping name -> dict(select=..., potential=V | current=A), or ElectrodeSpecs
+    law : str or ConductanceLaw
+        Conductance law name (``yade_electro.conductance.conductance_laws()``).
+    law_params : dict, optional
+        Parameters of the law (``container`` for 'voronoi'; ``threshold``, ``factor`` for
+        'continuum').
+    solver : str or solver object
+        'auto' (by size), 'cg', 'cg-deflated', 'cg-amg', 'direct' or an object with
+        ``solve(A, b, x0=None) -> (x, info)`` (see :mod:`yade_electro.solvers`).
+    measure : (str, str), optional
+        Electrodes between which R_eq is reported; default the first two.
+    reselect : bool
+        Re-evaluate the electrode selectors on every new structure instead of keeping the
+        elements chosen the first time (by id).
+    """
+
+    def __init__(self, resistivity, electrodes, law="continuum", law_params: Optional[dict] = None,
+                 solver="auto", measure: Optional[Sequence[str]] = None, reselect: bool = False):
+        self.material = resistivity if isinstance(resistivity, Material) else Material(resistivity=resistivity)
+        self.material.require_electrical()
+        self.specs = electrode_specs(electrodes)
+        if not self.specs:
+            raise BoundaryConditionError("give at least one electrode")
+        names = [s.name for s in self.specs]
+        if len(set(names)) != len(names):
+            raise BoundaryConditionError(f"electrode names must be unique, got {names}")
+        check_solver_name(solver)
+        self.law: ConductanceLaw = make_law(law, **dict(law_params or {}))
+        self.solver = solver
+        if measure is None:
+            measure = names[:2] if len(names) >= 2 else None
+        else:
+            measure = tuple(measure)
+            if len(measure) != 2 or any(m not in names for m in measure) or measure[0] == measure[1]:
+                raise BoundaryConditionError(f"measure={measure} must name two different electrodes of {names}")
+        self.measure = tuple(measure) if measure else None
+        self.memberships: Dict[str, Membership] = {s.name: Membership(s.name, s.select, reselect) for s in self.specs}
+        self.values: Dict[str, float] = {s.name: s.value for s in self.specs}
+        self.resistivity = self.material.resistivity
+        self.network = FactorNetwork(self.law)
+        self.problem: Optional[ConductionProblem] = None
+        self.solution: Optional[PotentialSolution] = None
+        self.conductance: Optional[np.ndarray] = None   # c on network.edges [S]
+        self.rebuilds = 0
+        self.updates = {"structure": 0, "topology": 0, "geometry": 0, "resistivity": 0}
+        self._rho_stale = False
+        self._graph_view = None
+
+    # -- values (owned here) -----------------------------------------------------------------
+    @property
+    def law_name(self) -> str:
+        return self.law.name
+
+    def set_electrode(self, name: str, value: float):
+        """Change an electrode's potential [V] or current [A] (no re-solve needed)."""
+        if name not in self.values:
+            raise BoundaryConditionError(f"no electrode named {name!r}; have {sorted(self.values)}")
+        self.values[name] = electrode_value(name, value)
+
+    def set_resistivity(self, resistivity):
+        """Change rho_e [ohm m] (scalar or per node); a value update at the next solve."""
+        self.resistivity = positive_property("resistivity", resistivity, None, " (ohm m)")
+        self._rho_stale = True
+
+    def reset(self):
+        """Forget everything derived from earlier graphs (network, solver setup); the electrode
+        membership is kept."""
+        self.network = FactorNetwork(self.law)
+        self.problem = None
+        self.solution = None
+
+    # -- structure / values ------------------------------------------------------------------
+    @property
+    def bond_graph(self) -> Optional[ContactGraph]:
+        """The graph of the last update (bonds read from the scene)."""
+        return self.network.graph
+
+    @property
+    def factor(self) -> Optional[np.ndarray]:
+        """Geometric factor g [m] on ``network_edges``."""
+        return self.network.factor
+
+    @property
+    def network_edges(self) -> np.ndarray:
+        """Edges of the kept network (node pairs); broken ones have conductance 0."""
+        return self.network.edges
+
+    @property
+    def graph(self) -> Optional[ContactGraph]:
+        """The network the current flows in: the bond graph's elements with ``network_edges``."""
+        if self.problem is None:
+            return None
+        g = self.bond_graph
+        if self.network.edges is g.edges:
+            return g
+        key = (id(g), id(self.network.edges))
+        if self._graph_view is None or self._graph_view[0] != key:
+            self._graph_view = (key, ContactGraph(g.pos, g.radius, self.network.edges, g.ids, g.revision))
+        return self._graph_view[1]
+
+    def _rho_edge(self, edges, n):
+        rho = self.resistivity
+        if np.ndim(rho) == 1 and np.shape(rho)[0] != n:
+            raise BoundaryConditionError(f"resistivity has {np.shape(rho)[0]} values but the packing has {n} elements")
+        return edge_resistivity(rho, edges)
+
+    def _build(self, graph: ContactGraph):
+        electrodes = []
+        for s in self.specs:
+            nodes = self.memberships[s.name].nodes(graph)
+            electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
+        edges = self.network.edges
+        c = self.network.factor / self._rho_edge(edges, graph.n_nodes)
+        solver = self.solver
+        if self.problem is not None and not isinstance(self.solver, str):
+            solver = self.problem.solver
+        self.problem = ConductionProblem(graph.n_nodes, edges, c, electrodes, solver=solver, coords=graph.pos)
+        self.conductance = c
+        self.rebuilds += 1
+        self.updates["structure"] += 1
+
+    def update(self, graph: ContactGraph) -> Optional[str]:
+        """Bring the kept problem to ``graph``; returns what changed: None, 'resistivity',
+        'geometry', 'topology' or 'structure' (see the module doc and
+        :class:`~yade_electro.conductance.FactorNetwork`)."""
+        if not isinstance(graph, ContactGraph):
+            raise TypeError(f"expected a ContactGraph, got {type(graph).__name__}")
+        kind = self.network.update(graph)
+        reselect = any(m.reselect for m in self.memberships.values())
+        if self.problem is None or kind == "structure" or (kind == "topology" and reselect):
+            self._rho_stale = False
+            self._build(graph)
+            return "structure"
+        if kind is None:
+            if not self._rho_stale:
+                return None
+            kind = "resistivity"
+        self._rho_stale = False
+        c = self.network.factor / self._rho_edge(self.network.edges, graph.n_nodes)
+        if np.array_equal(c, self.conductance):
+            return None
+        self.conductance = c
+        if self.problem.update_conductance(c) == "structure":
+            self.updates["structure"] += 1
+        self.updates[kind] += 1
+        return kind
+
+    def solve(self, graph: Optional[ContactGraph] = None,
+              values: Optional[Mapping[str, float]] = None) -> PotentialSolution:
+        """Potentials, currents and electrode figures on ``graph`` (default: the last one);
+        ``values`` sets electrode values (kept, as :meth:`set_electrode`)."""
+        if values:
+            for k, v in values.items():
+                self.set_electrode(k, v)
+        if graph is not None:
+            self.update(graph)
+        elif self.problem is None:
+            raise RuntimeError("no graph yet: call solve(graph) first")
+        elif self._rho_stale:
+            self.update(self.bond_graph)
+        self.solution = self.problem.solve(self.values)
+        return self.solution
+
+    def prepare(self, graph: ContactGraph) -> ConductionProblem:
+        """Build (or bring up to date) the Kirchhoff problem of ``graph``."""
+        self.update(graph)
+        return self.problem
+
+    # -- figures -----------------------------------------------------------------------------
+    @property
+    def equivalent_resistance(self) -> float:
+        """R_eq [ohm] between the two ``measure`` electrodes of the last solution."""
+        if self.solution is None or self.measure is None:
+            raise RuntimeError("no solution yet, or fewer than two electrodes")
+        return self.solution.equivalent_resistance(*self.measure)
+
+    def joule_power(self) -> np.ndarray:
+        """Power dissipated in each edge of ``network_edges`` by the last solution [W]."""
+        return self.solution.joule_power(self.conductance)
+
+    def summary(self) -> Dict[str, float]:
+        """One history row of the last solution: R_eq, electrode potentials/currents, power,
+        residual, solver figures, network size."""
+        sol = self.solution
+        if sol is None:
+            raise RuntimeError("no solution yet")
+        row = {"R_eq": self.equivalent_resistance if self.measure else float("nan")}
+        for name in sol.electrode_current:
+            row[f"V_{name}"] = sol.electrode_potential[name]
+            row[f"I_{name}"] = sol.electrode_current[name]
+        row["joule_power"] = float(np.sum(self.joule_power()))
+        row["n_nodes"] = int(self.bond_graph.n_nodes)
+        row["n_edges"] = int(np.count_nonzero(self.conductance > 0))
+        row["n_floating"] = int(sol.floating.sum())
+        row["residual"] = sol.residual
+        row["current_imbalance"] = sol.current_imbalance
+        row["iterations"] = int(sol.info.get("iterations", 0))
+        row["solve_time"] = float(sol.info.get("basis_time", 0.0))
+        return row

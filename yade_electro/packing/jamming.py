@@ -1,0 +1,202 @@
+"""Placement by jamming: FIRE relaxation of a soft-sphere overlap energy with the exact
+container wall, while the radii grow (the O'Hern et al. 2003 protocol). numpy/scipy only.
+
+Everything here works in units of a reference radius ``r0`` (positions ``x``, radii
+``rho``); :func:`yade_electro.packing.dense_packing` converts to metres.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+__all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps"]
+
+log = logging.getLogger(__name__)
+
+
+class Relaxer:
+    """Soft-sphere overlap energy minimiser in units of the mean radius.
+
+    Energy U = 1/2 sum_pairs max(0, s(rho_i + rho_j) - d_ij)^2
+             + 1/2 sum_i max(0, sdf(x_i) + s rho_i)^2,
+    minimised with FIRE (Bitzek et al. 2006) using a Verlet pair list (cKDTree).
+    """
+
+    def __init__(self, shape, rho, r0, skin=0.4):
+        self.shape, self.rho, self.r0, self.skin = shape, rho, r0, skin
+        self.rho_max = float(rho.max())
+        self.pairs = None
+        self.x_ref = None
+        self.s_ref = None
+        self.n_rebuild = 0
+        self.n_force = 0
+
+    def _pairs(self, x, s):
+        if self.pairs is not None:
+            disp = np.sqrt(np.max(np.einsum("ij,ij->i", x - self.x_ref, x - self.x_ref)))
+            if 2 * disp + 2 * (s - self.s_ref) * self.rho_max < self.skin:
+                return self.pairs
+        cut = 2 * s * self.rho_max + self.skin
+        self.pairs = cKDTree(x).query_pairs(cut, output_type="ndarray")
+        self.x_ref, self.s_ref = x.copy(), s
+        self.n_rebuild += 1
+        return self.pairs
+
+    def forces(self, x, s):
+        """Forces (n, 3) and the largest overlap (sphere-sphere or wall penetration)."""
+        self.n_force += 1
+        n = x.shape[0]
+        p = self._pairs(x, s)
+        i, j = p[:, 0], p[:, 1]
+        d = x[j] - x[i]
+        d2 = np.einsum("ij,ij->i", d, d)
+        rs = s * (self.rho[i] + self.rho[j])
+        m = d2 < rs * rs
+        F = np.zeros((n, 3))
+        maxov = 0.0
+        energy = 0.0
+        if np.any(m):
+            i, j, d, rs = i[m], j[m], d[m], rs[m]
+            dist = np.sqrt(d2[m])
+            ov = rs - dist
+            maxov = float(ov.max())
+            energy = 0.5 * float(ov @ ov)
+            f = d * (ov / np.maximum(dist, 1e-12))[:, None]
+            for k in range(3):
+                F[:, k] += np.bincount(j, f[:, k], n) - np.bincount(i, f[:, k], n)
+        rad = s * self.rho
+        for g, normal in self.shape.wall_terms(x * self.r0):
+            phi = g / self.r0 + rad
+            w = np.flatnonzero(phi > 0)
+            if w.size:
+                F[w] -= phi[w, None] * normal(w)
+                maxov = max(maxov, float(phi[w].max()))
+                energy += 0.5 * float(phi[w] @ phi[w])
+        self.energy = energy
+        return F, maxov
+
+    def minimise(self, x, s, tol, max_steps, dt0=0.1, dt_max=0.5, window=200, stall=0.7):
+        """FIRE from ``x`` at scale ``s``. Returns (x, max_overlap, status, steps) where
+        status is "ok" (max overlap < tol), "jammed" (the energy fell by less than a factor
+        ``stall`` over the last ``window`` steps, or the forces balance with overlaps left)
+        or "budget" (max_steps reached)."""
+        x = x.copy()
+        v = np.zeros_like(x)
+        dt, alpha, n_pos = dt0, 0.1, 0
+        F, maxov = self.forces(x, s)
+        e_hist = []
+        for step in range(1, max_steps + 1):
+            if maxov < tol:
+                return x, maxov, "ok", step
+            if step % window == 0:
+                e_hist.append(self.energy)
+                if len(e_hist) >= 2 and e_hist[-1] > stall * e_hist[-2]:
+                    return x, maxov, "jammed", step
+            fmax = np.sqrt(np.max(np.einsum("ij,ij->i", F, F)))
+            if fmax < 1e-3 * maxov:
+                return x, maxov, "jammed", step
+            P = np.einsum("ij,ij->", F, v)
+            if P > 0:
+                vn = np.sqrt(np.einsum("ij,ij->", v, v))
+                fn = np.sqrt(np.einsum("ij,ij->", F, F))
+                v = (1 - alpha) * v + alpha * vn / max(fn, 1e-300) * F
+                n_pos += 1
+                if n_pos > 5:
+                    dt = min(dt * 1.1, dt_max)
+                    alpha *= 0.99
+            else:
+                v[:] = 0.0
+                dt *= 0.5
+                alpha, n_pos = 0.1, 0
+            v += F * dt
+            x += v * dt
+            F, maxov = self.forces(x, s)
+        return x, maxov, ("ok" if maxov < tol else "budget"), max_steps
+
+
+def random_inside(shape, rad, r0, rng, max_rounds=200):
+    """Uniform random centres (dimensionless, units of r0) with sdf <= -rad (or <= 0 if a
+    sphere does not fit anywhere)."""
+    lo, hi = shape.bounds()
+    lo, hi = lo / r0, hi / r0
+    n = rad.size
+    out = np.empty((n, 3))
+    todo = np.arange(n)
+    for _ in range(max_rounds):
+        m = todo.size
+        if m == 0:
+            return out
+        cand = lo + (hi - lo) * rng.random((4 * m + 16, 3))
+        sd = shape.sdf(cand * r0) / r0
+        ok = cand[sd <= 0]
+        sd_ok = sd[sd <= 0]
+        take = min(m, ok.shape[0])
+        # accept a candidate for a given sphere only if the sphere fits
+        fits = sd_ok[:take] <= -rad[todo[:take]]
+        idx = todo[:take][fits]
+        out[idx] = ok[:take][fits]
+        todo = np.concatenate([todo[:take][~fits], todo[take:]])
+    raise ValueError("could not place the spheres inside the container: the radii are too "
+                     "large for it (ask for more spheres or a smaller r_mean)")
+
+
+def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume):
+    """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``)."""
+    n = rho.size
+    phi_nom = float(np.sum(4 / 3 * np.pi * (rho * r0) ** 3)) / volume  # fraction at s = 1
+    s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
+    rel = Relaxer(shape, rho, r0, skin=skin)
+    x = random_inside(shape, s * rho, r0, rng)
+    x, ov, status, steps = rel.minimise(x, s, tol, 20 * max_steps)
+    total = steps
+    if status != "ok":
+        raise RuntimeError(f"could not remove the overlaps of the initial random cloud "
+                           f"(fraction {phi_start}); max overlap {ov:.3g} r_mean")
+    x_ok, s_ok, ds = x, s, ds0
+    trials = 0
+    while ds >= ds_min and s_ok < s_max:
+        s_try = min(s_max, s_ok * (1 + ds))
+        x_try, ov, status, steps = rel.minimise(x_ok, s_try, tol, max_steps)
+        total += steps
+        trials += 1
+        log.debug("jam: s=%.5f fraction=%.4f %s in %d steps (ds=%.2g)", s_try,
+                  phi_nom * s_try ** 3, status, steps, ds)
+        if status == "ok":
+            x_ok, s_ok = x_try, s_try
+            ds = min(ds * 1.5, 0.05)
+        else:
+            ds *= 0.5
+    info = dict(fire_steps=int(total), trials=trials, pair_rebuilds=rel.n_rebuild,
+                radius_scale=float(s_ok))
+    return x_ok, s_ok, info
+
+
+
+
+def max_overlap(centers, radii, shape) -> float:
+    """Largest sphere-sphere overlap or wall penetration [m] (negative: none)."""
+    tree = cKDTree(centers)
+    p = tree.query_pairs(2 * radii.max(), output_type="ndarray")
+    worst = -np.inf
+    if len(p):
+        d = np.linalg.norm(centers[p[:, 1]] - centers[p[:, 0]], axis=1)
+        worst = float(np.max(radii[p[:, 0]] + radii[p[:, 1]] - d))
+    if shape is not None:
+        worst = max(worst, float(np.max(shape.sdf(centers) + radii)))
+    return worst
+
+
+def shrink_to_remove_overlaps(centers, radii, shape) -> float:
+    """Smallest relative shrink ``eps`` of all radii after which no pair overlaps and no
+    sphere crosses the container's wall constraints (plus 1e-9 for rounding)."""
+    eps = 0.0
+    p = cKDTree(centers).query_pairs(2 * radii.max(), output_type="ndarray")
+    if len(p):
+        d = np.linalg.norm(centers[p[:, 1]] - centers[p[:, 0]], axis=1)
+        rs = radii[p[:, 0]] + radii[p[:, 1]]
+        eps = max(eps, float(np.max((rs - d) / rs)))
+    for g, _ in shape.wall_terms(centers):
+        eps = max(eps, float(np.max((g + radii) / radii)))
+    return eps + 1e-9 if eps > 0 else 0.0

@@ -1,0 +1,447 @@
+"""Linear solvers for the SPD systems of the network problems, with one protocol and kept setup.
+
+Protocol (PyAMG-like): ``solver.solve(A, b, x0=None) -> (x, info)``. A solver keeps its setup
+(preconditioner, coarse space, factorisation) while it is given the same matrix object ``A``.
+When the *values* of ``A`` change in place (same sparsity pattern), the owner calls
+``solver.update(A)``: each solver then does the least work that keeps it right (see below).
+A different matrix object means a new structure and a full setup. ``x0`` is a warm start
+(the previous solution); ``info`` reports ``iterations``, ``residual`` (relative), ``setup``
+(True when this call made a full setup) and times.
+
+Solvers
+-------
+``'cg'`` (``'cg-jacobi'``)
+    Conjugate gradient with the diagonal (Jacobi) preconditioner. ``update``: new diagonal.
+``'cg-deflated'``
+    CG with the Jacobi preconditioner and a deflation (coarse) space of piecewise-constant
+    vectors on clusters of about ``cluster_size`` neighbour spacings (subdomain deflation,
+    Frank & Vuik, SIAM J. Sci. Comput. 23, 2001; algorithm of Saad et al., SIAM J. Sci.
+    Comput. 21, 2000). The clusters come from the node coordinates (``set_geometry``; without
+    them, from runs of a reverse Cuthill-McKee ordering of the matrix graph); the
+    coarse matrix ``E = W^T A W`` is re-assembled by one scatter and refactorised on
+    ``update`` (dense Cholesky up to 1,500 clusters, sparse LU above). The smooth error modes
+    that make Jacobi-CG slow on elongated or fine packings are removed exactly, so the
+    iteration count no longer grows with the number of elements.
+``'cg-amg'``
+    CG with a PyAMG smoothed-aggregation V-cycle. ``update``: the hierarchy is kept and only
+    its finest operator replaced; it is rebuilt when an iteration count exceeds
+    ``resetup_factor`` (1.5) times the count of the first solve after the last setup, i.e.
+    when the kept hierarchy no longer fits the matrix (large value changes).
+``'direct'``
+    Sparse LU (SuperLU). ``update``: refactorisation (there is no cheaper exact update).
+``'auto'``
+    The solver measured fastest for the size (``bench/bench_solvers.py``; see
+    :func:`auto_solver_name`).
+
+Tolerance: CG stops at ``||A x - b|| <= max(rtol ||b||, atol)`` (default rtol 1e-10, atol 0;
+``solve(A, b, x0, atol=...)`` sets a floor for right-hand sides at rounding level) and raises
+:class:`~yade_electro.errors.SolverError` if it cannot get there.
+"""
+from __future__ import annotations
+
+import logging
+import time
+import warnings
+from typing import Optional
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .errors import SolverError
+
+__all__ = ["make_solver", "solver_names", "auto_solver_name", "CGSolver", "DeflatedCGSolver", "AMGSolver",
+           "DirectSolver", "AUTO_DEFLATION_FROM"]
+
+log = logging.getLogger(__name__)
+
+#: From this many unknowns on, ``'auto'`` picks ``'cg-deflated'`` (below it, ``'cg'``).
+#: Measured by ``bench/bench_solvers.py`` (see the README's solver table).
+AUTO_DEFLATION_FROM = 2000
+
+
+def auto_solver_name(n_unknowns: int) -> str:
+    """The solver ``'auto'`` stands for at a given size: ``'cg'`` below
+    :data:`AUTO_DEFLATION_FROM` unknowns, ``'cg-deflated'`` from there on."""
+    return "cg-deflated" if n_unknowns >= AUTO_DEFLATION_FROM else "cg"
+
+
+def _residual(A, x, b):
+    nb = np.linalg.norm(b)
+    r = np.linalg.norm(A @ x - b)
+    return r / nb if nb > 0 else r
+
+
+class _Solver:
+    name = "?"
+
+    def __init__(self):
+        self._A = None
+        self.setup_time = 0.0
+        self.n_setups = 0
+        self.n_updates = 0
+
+    def _ensure_setup(self, A) -> bool:
+        if A is not self._A:
+            t = time.perf_counter()
+            self._setup(A)
+            self._A = A
+            self.setup_time = time.perf_counter() - t
+            self.n_setups += 1
+            return True
+        return False
+
+    def update(self, A):
+        """The values of ``A`` (the kept matrix object) changed in place, same pattern."""
+        if A is not self._A:
+            self._A = None          # a new structure: full setup at the next solve
+            return
+        self.n_updates += 1
+        self._update(A)
+
+    def _update(self, A):
+        self._setup(A)
+
+    def set_geometry(self, coords, spacing=None):
+        """Coordinates (n, 3) [m] of the unknowns and their mean neighbour spacing [m]; used by
+        solvers that build a coarse space, ignored by the others."""
+
+    def _setup(self, A):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+class DirectSolver(_Solver):
+    """Sparse LU (SuperLU, COLAMD ordering), kept while the matrix is unchanged and redone on
+    ``update``. Exact to rounding."""
+
+    name = "direct"
+
+    def _setup(self, A):
+        self._lu = spla.splu(sp.csc_matrix(A), permc_spec="COLAMD")
+
+    def solve(self, A, b, x0=None, atol: float = 0.0):
+        fresh = self._ensure_setup(A)
+        x = self._lu.solve(np.asarray(b, dtype=float))
+        if not np.all(np.isfinite(x)):
+            raise SolverError("the direct solve produced non-finite values (singular matrix?)")
+        return x, {"solver": self.name, "iterations": 0, "residual": _residual(A, x, b),
+                   "setup": fresh, "setup_time": self.setup_time}
+
+
+def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
+    """Preconditioned CG from ``x`` (modified in place) to ``||r|| <= max(rtol ||b||, atol)``;
+    ``deflate`` = (coarse_correct, project) makes it the deflated CG of Saad et al. (2000).
+    A start worse than zero (``||b - A x|| > ||b||``) is replaced by zero. Returns (x,
+    iterations, relative residual)."""
+    nb = np.linalg.norm(b)
+    if nb == 0:
+        x[:] = 0.0
+        return x, 0, 0.0
+    if not np.isfinite(nb):
+        raise SolverError(f"{name}: the right-hand side is not finite (||b|| = {nb}); check sources and values")
+    tol = max(rtol * nb, atol)
+    r = b - A @ x
+    if np.linalg.norm(r) > nb:
+        x[:] = 0.0
+        r = b.copy()
+    if deflate is not None:
+        coarse, project = deflate
+        x += coarse(r)                      # remove the coarse error components at once
+        r = b - A @ x
+    rn = np.linalg.norm(r)
+    it = 0
+    if rn > tol:
+        z = M(r)
+        p = z.copy() if deflate is None else z - project(z)
+        rz = r @ z
+        while it < maxiter:
+            it += 1
+            q = A @ p
+            pq = p @ q
+            if not pq > 0:
+                raise SolverError(f"{name} broke down (p.Ap = {pq:.3g} <= 0): the matrix is not positive "
+                                  "definite; check for negative or non-finite conductances")
+            a = rz / pq
+            x += a * p
+            r -= a * q
+            rn = np.sqrt(r @ r)
+            if rn <= tol:
+                break
+            z = M(r)
+            rz_new = r @ z
+            p *= rz_new / rz
+            p += z
+            if deflate is not None:
+                p -= project(z)
+            rz = rz_new
+    res = np.linalg.norm(b - A @ x) / nb
+    if not np.all(np.isfinite(x)):
+        raise SolverError(f"{name} produced non-finite values; check conductances for inf/nan")
+    return x, it, res
+
+
+class CGSolver(_Solver):
+    """Jacobi-preconditioned conjugate gradient (the paper's choice) for SPD systems.
+
+    Parameters
+    ----------
+    rtol : float
+        Stop when ||A x - b|| <= rtol ||b|| (default 1e-10).
+    preconditioner : {'jacobi', 'none'}
+        The diagonal, or none (for tests). AMG is :class:`AMGSolver`.
+    maxiter : int, optional
+        Default 10 n.
+    """
+
+    name = "cg"
+
+    def __init__(self, rtol: float = 1e-10, preconditioner: str = "jacobi", maxiter: Optional[int] = None):
+        super().__init__()
+        if preconditioner not in ("jacobi", "none"):
+            raise ValueError(f"preconditioner must be 'jacobi' or 'none' (AMG is solver 'cg-amg'), "
+                             f"got {preconditioner!r}")
+        if not (0 < rtol < 1):
+            raise ValueError(f"rtol must be in (0, 1), got {rtol}")
+        self.rtol, self.preconditioner, self.maxiter = float(rtol), preconditioner, maxiter
+
+    def _setup(self, A):
+        self._Acsr = A if sp.isspmatrix_csr(A) else sp.csr_matrix(A)
+        self._set_diagonal()
+
+    def _set_diagonal(self):
+        if self.preconditioner == "none":
+            self._M = lambda r: r
+            return
+        d = self._Acsr.diagonal()
+        if np.any(d <= 0):
+            raise SolverError("the matrix has a non-positive diagonal entry: a node with no conducting edge "
+                              "was left among the unknowns")
+        inv = 1.0 / d
+        self._M = lambda r: inv * r
+
+    def _update(self, A):
+        self._set_diagonal()
+
+    def _deflation(self):
+        return None
+
+    def solve(self, A, b, x0=None, atol: float = 0.0):
+        """Solve ``A x = b`` from ``x0`` to ``||A x - b|| <= max(rtol ||b||, atol)``."""
+        fresh = self._ensure_setup(A)
+        b = np.asarray(b, dtype=float)
+        n = b.shape[0]
+        x = np.zeros(n) if x0 is None else np.array(x0, dtype=float, copy=True)
+        t = time.perf_counter()
+        x, it, res = _pcg(self._Acsr, b, x, self._M, self.rtol, self.maxiter or 10 * n + 10, self.name,
+                          self._deflation(), atol)
+        nb = np.linalg.norm(b)
+        if res * nb > 10 * max(self.rtol * nb, atol):
+            raise SolverError(f"{self.name} did not converge: relative residual {res:.3e} > rtol {self.rtol:g} "
+                              f"after {it} iterations; raise maxiter or use solver='direct'")
+        return x, {"solver": self.name, "iterations": it, "residual": res, "setup": fresh,
+                   "setup_time": self.setup_time, "iteration_time": time.perf_counter() - t}
+
+
+class DeflatedCGSolver(CGSolver):
+    """Jacobi-CG deflated by piecewise-constant vectors on spatial clusters (see module doc).
+
+    Parameters
+    ----------
+    rtol, maxiter : as :class:`CGSolver`
+    cluster_size : float
+        Cluster edge length in mean neighbour spacings (default 3, the fastest measured on
+        the rod packings: 35 iterations at 5,000 and 20,000 elements against 134 and 209
+        for Jacobi-CG).
+    """
+
+    name = "cg-deflated"
+    DENSE_LIMIT = 1500
+
+    def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, cluster_size: float = 3.0):
+        super().__init__(rtol=rtol, preconditioner="jacobi", maxiter=maxiter)
+        if not cluster_size > 0:
+            raise ValueError(f"cluster_size must be > 0, got {cluster_size}")
+        self.cluster_size = float(cluster_size)
+        self._coords = None
+        self._spacing = None
+
+    def set_geometry(self, coords, spacing=None):
+        coords = np.asarray(coords, dtype=float)
+        if coords.ndim != 2 or coords.shape[1] != 3:
+            raise ValueError(f"coords must be (n, 3), got {coords.shape}")
+        self._coords, self._spacing = coords, spacing
+        self._A = None                                   # new clusters at the next solve
+
+    def _clusters(self, A):
+        n = A.shape[0]
+        X = self._coords
+        if X is None or X.shape[0] != n:
+            # no geometry: consecutive runs of a reverse Cuthill-McKee ordering (compact
+            # groups of neighbours), of the size a spatial cluster would have
+            from scipy.sparse.csgraph import reverse_cuthill_mckee
+            order = reverse_cuthill_mckee(A.tocsr(), symmetric_mode=True)
+            size = max(int(round(0.5 * self.cluster_size ** 3)), 2)
+            lab = np.empty(n, dtype=np.int64)
+            lab[order] = np.arange(n) // size
+            return lab, int(lab.max()) + 1 if n else 0
+        lo, hi = X.min(axis=0), X.max(axis=0)
+        h = self._spacing
+        if not h or not np.isfinite(h) or h <= 0:
+            h = float(np.prod(np.maximum(hi - lo, 1e-300))) ** (1 / 3) / max(n, 1) ** (1 / 3)
+        cell = np.floor((X - lo) / (self.cluster_size * h)).astype(np.int64)
+        _, lab = np.unique(cell, axis=0, return_inverse=True)
+        return lab.reshape(-1), int(lab.max()) + 1
+
+    def _setup(self, A):
+        super()._setup(A)
+        A = self._Acsr
+        n = A.shape[0]
+        lab, k = self._clusters(A)
+        self._lab, self._k = lab, k
+        rows = np.repeat(np.arange(n), np.diff(A.indptr))
+        cols = A.indices
+        # W^T A (k x n): each non-zero (i, j) of A adds to (lab_i, j)
+        key = lab[rows] * n + cols
+        ukey, slot = np.unique(key, return_inverse=True)
+        self._wta_slot = slot
+        # a CSR matrix whose data[t] is the entry of the sorted unique key ukey[t]
+        indptr = np.searchsorted(ukey // n, np.arange(k + 1))
+        self._WtA = sp.csr_matrix((np.zeros(ukey.size), (ukey % n).astype(np.int32), indptr), shape=(k, n))
+        # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
+        ekey = lab[rows] * k + lab[cols]
+        uek, eslot = np.unique(ekey, return_inverse=True)
+        self._e_key, self._e_slot = uek, eslot
+        self._coarse_values()
+
+    def _coarse_values(self):
+        A, k = self._Acsr, self._k
+        self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
+        ev = np.bincount(self._e_slot, A.data, self._e_key.size)
+        if k <= self.DENSE_LIMIT:
+            E = np.zeros(k * k)
+            E[self._e_key] = ev
+            E = E.reshape(k, k)
+            try:
+                cf = sla.cho_factor(E, check_finite=False)
+            except np.linalg.LinAlgError as exc:
+                raise SolverError(f"the coarse matrix of 'cg-deflated' is not positive definite ({exc})") from None
+            self._coarse_solve = lambda v: sla.cho_solve(cf, v, check_finite=False)
+        else:
+            E = sp.csc_matrix((ev, (self._e_key // k, self._e_key % k)), shape=(k, k))
+            lu = spla.splu(E, permc_spec="COLAMD")
+            self._coarse_solve = lu.solve
+        lab, k = self._lab, self._k
+        WtA, coarse_solve = self._WtA, self._coarse_solve
+
+        def coarse(r):                       # W E^-1 W^T r
+            return coarse_solve(np.bincount(lab, r, k))[lab]
+
+        def project(z):                      # W E^-1 (A W)^T z
+            return coarse_solve(WtA @ z)[lab]
+        self._defl = (coarse, project)
+
+    def _update(self, A):
+        self._set_diagonal()
+        self._coarse_values()
+
+    def _deflation(self):
+        return self._defl
+
+    def solve(self, A, b, x0=None, atol: float = 0.0):
+        x, info = super().solve(A, b, x0, atol)
+        info["clusters"] = self._k
+        return x, info
+
+
+class AMGSolver(CGSolver):
+    """CG preconditioned by a PyAMG smoothed-aggregation V-cycle whose hierarchy is kept across
+    value changes (see module doc).
+
+    Parameters
+    ----------
+    rtol, maxiter : as :class:`CGSolver`
+    resetup_factor : float
+        Rebuild the hierarchy when a solve takes more than this many times the iterations of
+        the first solve after the last setup (default 1.5).
+    """
+
+    name = "cg-amg"
+
+    def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, resetup_factor: float = 1.5):
+        super().__init__(rtol=rtol, preconditioner="jacobi", maxiter=maxiter)
+        try:
+            import pyamg  # noqa: F401,F811
+        except ImportError:
+            raise SolverError("solver 'cg-amg' needs PyAMG (install it with `make install` or "
+                              "`pip install pyamg`), or use solver='cg-deflated'") from None
+        self.preconditioner = "amg"
+        self.resetup_factor = float(resetup_factor)
+        self._ref_iterations = None
+        self.n_resetups = 0
+
+    def _setup(self, A):
+        import pyamg
+        self._Acsr = A if sp.isspmatrix_csr(A) else sp.csr_matrix(A)
+        self._ml = pyamg.smoothed_aggregation_solver(self._Acsr, symmetry="symmetric", max_coarse=200)
+        self._M = self._ml.aspreconditioner(cycle="V")
+        self._ref_iterations = None
+
+    def _update(self, A):
+        # keep the hierarchy, give it the new finest operator
+        self._ml.levels[0].A = self._Acsr
+        self._M = self._ml.aspreconditioner(cycle="V")
+
+    def solve(self, A, b, x0=None, atol: float = 0.0):
+        x, info = super().solve(A, b, x0, atol)
+        it = info["iterations"]
+        if self._ref_iterations is None:
+            self._ref_iterations = max(it, 1)
+        elif it > self.resetup_factor * self._ref_iterations:
+            log.info("cg-amg: %d iterations against %d after the last setup: rebuilding the hierarchy",
+                     it, self._ref_iterations)
+            self._A = None                       # full setup at the next solve
+            self.n_resetups += 1
+        return x, info
+
+
+_SOLVERS = {"direct": DirectSolver, "cg": CGSolver, "cg-jacobi": CGSolver, "cg-deflated": DeflatedCGSolver,
+            "cg-amg": AMGSolver}
+
+
+def solver_names() -> tuple:
+    """Names :func:`make_solver` knows (plus ``'auto'``)."""
+    return tuple(sorted(list(_SOLVERS) + ["auto"]))
+
+
+def make_solver(solver="auto", n_unknowns: Optional[int] = None, **kw):
+    """A solver object from a name (see module doc), or an object with ``solve(A, b, x0=None)
+    -> (x, info)`` passed through. ``'auto'`` needs ``n_unknowns``."""
+    if hasattr(solver, "solve"):
+        return solver
+    if solver == "auto":
+        if n_unknowns is None:
+            raise ValueError("solver='auto' needs the number of unknowns")
+        solver = auto_solver_name(n_unknowns)
+    try:
+        cls = _SOLVERS[solver]
+    except (KeyError, TypeError):
+        raise ValueError(f"unknown solver {solver!r}; known: {', '.join(solver_names())}") from None
+    if solver == "cg-amg":
+        try:
+            return cls(**kw)
+        except SolverError as exc:
+            warnings.warn(f"{exc}; falling back to 'cg-deflated'", stacklevel=2)
+            return DeflatedCGSolver(**{k: v for k, v in kw.items() if k in ("rtol", "maxiter")})
+    return cls(**kw)
+
+
+def check_solver_name(solver) -> None:
+    """Raise ValueError for an unknown solver name (objects with ``solve`` pass)."""
+    if hasattr(solver, "solve"):
+        return
+    if solver != "auto" and solver not in _SOLVERS:
+        raise ValueError(f"unknown solver {solver!r}; known: {', '.join(solver_names())}")
+
+
+__all__ += ["check_solver_name"]

@@ -1,0 +1,150 @@
+"""Bonded packings in YADE: spheres added to ``O.bodies`` with a cohesive material, and every
+pair closer than ``detection_factor * (r_i + r_j)`` bonded by YADE itself, without prestress.
+
+The placement is :func:`yade_electro.packing.dense_packing` (numpy only); this module is the
+YADE half of the recipe (``CohFrictMat`` or ``JCFpmMat`` bonds).
+
+Units: SI.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from ..packing.statistics import DEFAULT_DETECTION_FACTOR
+
+__all__ = ["steel_304L", "add_bonded_packing"]
+
+log = logging.getLogger(__name__)
+
+
+def steel_304L(**overrides):
+    """A ``CohFrictMat`` for 304L stainless steel (E = 210 GPa, nu = 0.3, 7900 kg/m^3).
+
+    The bond strengths (``normalCohesion = shearCohesion = 5.2e8`` Pa, about the tensile
+    strength) and the friction angle (atan 0.5) are placeholders, not a calibration of the
+    bonded model; calibrate them (e.g. on a tensile test) before any fracture study.
+    """
+    from yade.wrapper import CohFrictMat
+    kw = dict(young=210e9, poisson=0.3, density=7900.0, frictionAngle=float(np.arctan(0.5)),
+              isCohesive=True, normalCohesion=5.2e8, shearCohesion=5.2e8,
+              momentRotationLaw=True, label="steel_304L")
+    kw.update(overrides)
+    return CohFrictMat(**kw)
+
+
+def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTION_FACTOR,
+                       engines="default", damping=0.2, dt_safety=0.5, color=None):
+    """Add a packing to ``O.bodies`` and bond neighbours with cohesive YADE interactions.
+
+    Every pair with ``|x_i - x_j| < detection_factor (r_i + r_j)`` (see :func:`bond_pairs`)
+    is bonded by YADE: one step with an engine list whose ``Bo1_Sphere_Aabb.
+    aabbEnlargeFactor`` and ``Ig2_Sphere_Sphere_ScGeom6D.interactionDetectionFactor``
+    equal ``detection_factor`` and whose Ip2 sets the cohesion now; no integrator runs
+    during that step, so nothing moves. The factors are then reset to 1 and cohesion is not
+    given to later contacts. With ``CohFrictMat``, each bond's reference normal
+    displacement (``CohFrictPhys.unp``) is set to its initial penetration (negative across
+    a gap), so the bonded packing starts stress-free instead of pulling the gaps shut.
+
+    Parameters
+    ----------
+    packing : SpherePacking
+        From :func:`dense_packing`.
+    material : yade Material or int or str, optional
+        A ``CohFrictMat`` (default :func:`steel_304L`) or ``JCFpmMat`` instance, or the id
+        or label of a material already in ``O.materials``.
+    detection_factor : float
+        >= 1; 1.04 (gap below ~8 % of r_mean) gives the paper's coordination of 6.7 on the
+        5,000-element rod (see docs/packing.md).
+    engines : "default" or list or None
+        ``"default"``: ForceResetter, InsertionSortCollider, InteractionLoop with the
+        cohesive law, NewtonIntegrator(damping) and ``O.dt = dt_safety * PWaveTimeStep()``.
+        A list: installed as ``O.engines`` after bonding (its functors must accept the
+        bond types: ScGeom6D + CohFrictPhys, or ScGeom + JCFpmPhys). None: the bonding
+        engines are left in place (factors reset to 1, no integrator) and ``O.dt`` untouched.
+    damping : float
+        NewtonIntegrator numerical damping of the default engines.
+    dt_safety : float
+        Fraction of ``PWaveTimeStep()`` used for ``O.dt`` with the default engines.
+    color : 3-tuple, optional
+        Colour of the spheres.
+
+    Returns
+    -------
+    list of int
+        Body ids of the spheres, in the order of ``packing.centers``.
+    """
+    import yade
+    from yade import utils
+    from yade import wrapper as W
+    O = yade.Omega()
+    k = float(detection_factor)
+    if not k >= 1.0:
+        raise ValueError(f"detection_factor must be >= 1, got {k}")
+    if material is None:
+        mat_id = O.materials.append(steel_304L())
+    elif isinstance(material, (int, str)):
+        mat_id = O.materials[material].id
+    else:
+        mat_id = material.id if material.id >= 0 else O.materials.append(material)
+    mat = O.materials[mat_id]
+    kind = type(mat).__name__
+    if kind == "CohFrictMat":
+        if not mat.isCohesive:
+            raise ValueError("the CohFrictMat must have isCohesive=True to be bonded")
+        ig2 = W.Ig2_Sphere_Sphere_ScGeom6D(interactionDetectionFactor=k)
+        ip2 = W.Ip2_CohFrictMat_CohFrictMat_CohFrictPhys(setCohesionNow=True,
+                                                        setCohesionOnNewContacts=False)
+        law = W.Law2_ScGeom6D_CohFrictPhys_CohesionMoment()
+    elif kind == "JCFpmMat":
+        ig2 = W.Ig2_Sphere_Sphere_ScGeom(interactionDetectionFactor=k)
+        ip2 = W.Ip2_JCFpmMat_JCFpmMat_JCFpmPhys(cohesiveTresholdIteration=1)
+        law = W.Law2_ScGeom_JCFpmPhys_JointedCohesiveFrictionalPM()
+    else:
+        raise ValueError(f"material must be a CohFrictMat or a JCFpmMat, got {kind}")
+    kw = {} if color is None else {"color": tuple(color)}
+    ids = O.bodies.append([utils.sphere(tuple(c), float(r), material=mat_id, **kw)
+                           for c, r in zip(packing.centers.tolist(), packing.radii.tolist())])
+    bo1 = W.Bo1_Sphere_Aabb(aabbEnlargeFactor=k)
+    collider = W.InsertionSortCollider([bo1])
+    # the cohesive law must not run during the bonding step: it would break the bonds across
+    # gaps before their reference distance (unp) is set. A frictional law that never erases
+    # interactions stands in (it handles ScGeom6D/CohFrictPhys through their base classes).
+    # (JCFpm stores the initial distance itself, its own law is safe.)
+    stand_in = (W.Law2_ScGeom_FrictPhys_CundallStrack(neverErase=True) if kind == "CohFrictMat"
+                else law)
+    loop = W.InteractionLoop([ig2], [ip2], [stand_in])
+    saved_engines, saved_dt = O.engines, O.dt
+    newton = W.NewtonIntegrator(damping=damping, dead=True)  # the collider wants one
+    O.engines = [W.ForceResetter(), collider, loop, newton]
+    O.dt = min(O.dt, utils.PWaveTimeStep()) if O.dt > 0 else utils.PWaveTimeStep()
+    O.step()
+    O.dt = saved_dt
+    bo1.aabbEnlargeFactor = 1.0
+    ig2.interactionDetectionFactor = 1.0
+    if kind == "CohFrictMat":
+        ip2.setCohesionNow = False
+    else:
+        ip2.cohesiveTresholdIteration = O.iter  # no cohesion for later contacts
+    ours = set(ids)
+    n_bonds = 0
+    for i in O.interactions:
+        if i.id1 in ours and i.id2 in ours:
+            if kind == "CohFrictMat":
+                i.phys.unp = i.geom.penetrationDepth
+            n_bonds += 1
+    loop.lawDispatcher.functors = [law]
+    log.info("add_bonded_packing: %d spheres, %d bonds (detection factor %.4g)", len(ids),
+             n_bonds, k)
+    if engines == "default":
+        newton.dead = False
+        O.engines = [W.ForceResetter(), collider, loop, newton]
+        O.dt = dt_safety * utils.PWaveTimeStep()
+    elif engines is None:
+        pass  # bonding engines stay, the integrator still dead
+    else:
+        O.engines = list(engines)
+    del saved_engines
+    return list(ids)
+

@@ -1,0 +1,90 @@
+"""An engine's configuration and state, kept in the scene itself so that ``O.save`` /
+``O.load`` carry them.
+
+YADE saves ``O.tags`` (a dict of strings) with the scene. Each engine keeps two tags:
+
+* ``yade_electro:<label>:config``: everything needed to build the engine again (materials,
+  law and its reference geometry, electrode and boundary-condition membership *by body id*,
+  solver, options), pickled and base64-encoded; written when the engine is built;
+* ``yade_electro:<label>:state``: what changes every call (electrode values, thermal clock,
+  energy ledger, fixed temperatures, the iteration and time of the last call, the number of
+  history rows), JSON; written at every call (about 30 us).
+
+Temperatures are in ``b.state.temp`` (YADE's ThermalState), which YADE saves itself.
+"""
+from __future__ import annotations
+
+import base64
+import json
+import pickle
+from typing import Optional
+
+__all__ = ["PREFIX", "config_key", "state_key", "save_config", "load_config", "save_state", "load_state",
+           "saved_labels", "forget"]
+
+PREFIX = "yade_electro"
+
+
+def config_key(label: str) -> str:
+    return f"{PREFIX}:{label}:config"
+
+
+def state_key(label: str) -> str:
+    return f"{PREFIX}:{label}:state"
+
+
+def _tags(O):
+    return O.tags
+
+
+def save_config(O, label: str, config: dict) -> None:
+    """Store an engine's configuration in the scene (pickled; raises TypeError with the name
+    of the part that cannot be pickled)."""
+    try:
+        blob = pickle.dumps(config, protocol=4)
+    except Exception as exc:
+        raise TypeError(f"the configuration of engine {label!r} cannot be saved with the scene ({exc}); "
+                        "give selectors, containers and options as plain data or YADE predicates") from None
+    _tags(O)[config_key(label)] = base64.b64encode(blob).decode("ascii")
+
+
+def load_config(O, label: str) -> Optional[dict]:
+    """The configuration saved under ``label``, or None."""
+    tags = _tags(O)
+    key = config_key(label)
+    if key not in tags.keys() or not tags[key]:
+        return None
+    return pickle.loads(base64.b64decode(tags[key].encode("ascii")))
+
+
+def save_state(O, label: str, state: dict) -> None:
+    """Store an engine's changing state (JSON) in the scene."""
+    _tags(O)[state_key(label)] = json.dumps(state)
+
+
+def load_state(O, label: str) -> Optional[dict]:
+    """The state saved under ``label``, or None."""
+    tags = _tags(O)
+    key = state_key(label)
+    if key not in tags.keys() or not tags[key]:
+        return None
+    return json.loads(tags[key])
+
+
+def saved_labels(O) -> list:
+    """Labels of the engines whose configuration the scene holds."""
+    out = []
+    tags = _tags(O)
+    for k in tags.keys():
+        parts = str(k).split(":")
+        if len(parts) == 3 and parts[0] == PREFIX and parts[2] == "config" and tags[k]:
+            out.append(parts[1])
+    return sorted(out)
+
+
+def forget(O, label: str) -> None:
+    """Clear an engine's tags in the scene (YADE's tags cannot be deleted: they are emptied)."""
+    tags = _tags(O)
+    for key in (config_key(label), state_key(label)):
+        if key in tags.keys():
+            tags[key] = ""
