@@ -118,7 +118,6 @@ def run_joule(n=5000, seed=1, law="voronoi", theta="backward-euler", thermal_dt=
     from yade import pack
     from yade_electro.yade import ElectroThermalEngine
     from yade_electro.yade import packing as P
-    from yade_electro.voronoi import cell_volume_of
 
     O = yade.Omega()
     O.reset()
@@ -129,24 +128,21 @@ def run_joule(n=5000, seed=1, law="voronoi", theta="backward-euler", thermal_dt=
     r_mean = float(np.mean(packing.radii))
     z = packing.centers[:, 2]
     bottom, top = rod.end_layers(z, packing.radii, r_mean, gap)
-    law_params, options = None, {}
-    if law == "voronoi":
-        law_params = {"container": shape}
-        options["cell_volume"] = cell_volume_of(shape)
+    # with the voronoi law the capacities are its bounded cell volumes (the default)
+    law_params = {"container": shape} if law == "voronoi" else None
     t0 = time.perf_counter()
     engine = ElectroThermalEngine(
         rod.RHO_304L, {"top": dict(select=ids[top], potential=voltage),
                        "bottom": dict(select=ids[bottom], potential=0.0)},
         DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T0, eta=1.0, theta=theta, thermal_dt=thermal_dt,
-        law=law, law_params=law_params, iterPeriod=1, history=history, coupled_options=options,
-        label="joule_rod")
+        law=law, law_params=law_params, iterPeriod=1, history=history, label="joule_rod")
     O.engines = O.engines + [engine.runner]
     O.run(int(n_calls), True)
     t_run = time.perf_counter() - t0
 
     coupled = engine.coupled
     g = coupled.graph
-    C = np.asarray(coupled.heat.capacity)
+    C = np.asarray(coupled.capacity)
     rows = engine.history.rows
     series_t = np.array([0.0] + [r["time"] for r in rows])
     series_mean = np.array([T0] + [r["T_mean"] for r in rows])

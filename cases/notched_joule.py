@@ -213,37 +213,14 @@ def slab_key(half_width, name="T_slab"):
 
 
 # --------------------------------------------------------------------------- DEM
-def capacity_option(law, shape):
-    """(coupled_options, record): Voronoi-cell capacities for 'voronoi' when available.
-
-    ``record["capacity"]`` says what was used: ``"fv"`` (paper: rho c V_i / fv_i) or
-    ``"voronoi_cells"`` (rho c V_cell). Cells for which ``voronoi_cell_volumes`` returns a
-    non-positive or non-finite volume (seen at a re-entrant notch corner, see the report)
-    keep the fv capacity of their element, with a warning; ``record["n_bad_cells"]`` counts
-    them."""
-    record = {"capacity": "fv", "n_bad_cells": 0}
+def capacity_record(law, model):
+    """What the capacities are: ``"fv"`` (paper: rho c V_i / fv_i) or, with 'voronoi', the
+    law's bounded cell volumes (``"voronoi_cells"``, rho c V_cell, the model's default; a
+    non-positive cell volume would be refused by the model, so ``n_bad_cells`` is 0)."""
     if law != "voronoi":
-        return {}, record
-    try:
-        from yade_electro.voronoi import voronoi_cell_volumes
-    except ImportError:
-        return {}, record
-    from yade_electro.surfaces import volume_fraction
-
-    def cell_volume(g):
-        v = np.asarray(voronoi_cell_volumes(g.pos, g.radius, shape), dtype=float)
-        bad = ~(v > 0) | ~np.isfinite(v)
-        record["cell_volume_sum"] = float(np.sum(v[~bad]))
-        record["n_bad_cells"] = int(bad.sum())
-        if bad.any():
-            import warnings
-            warnings.warn(f"voronoi_cell_volumes gave {int(bad.sum())} non-positive cell volume(s): "
-                          "those elements keep the fv capacity", stacklevel=2)
-            v = v.copy()
-            v[bad] = (g.volume / volume_fraction(g))[bad]
-        record["capacity"] = "voronoi_cells"
-        return v
-    return {"cell_volume": cell_volume}, record
+        return {"capacity": "fv", "n_bad_cells": 0}
+    return {"capacity": "voronoi_cells", "n_bad_cells": 0,
+            "cell_volume_sum": float(np.sum(model.capacity) / (DENSITY * SPECIFIC_HEAT))}
 
 
 def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, nsteps=100,
@@ -265,19 +242,19 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     r_mean = float(np.mean(packing.radii))
     end0, end1 = end_layers(packing.centers[:, 0], packing.radii, r_mean, gap)
     law_params = {"container": shape} if law == "voronoi" else None
-    options, capacity = capacity_option(law, shape)
     engine = ElectroThermalEngine(
         RHO_E, {"end1": dict(select=ids[end1], potential=voltage),
                 "end0": dict(select=ids[end0], potential=0.0)},
         density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY, temperature=T0,
         beta=0.0, eta=1.0, theta="backward-euler", thermal_dt=t_end / nsteps, law=law,
-        law_params=law_params, solver=solver, coupled_options=options, iterPeriod=1,
+        law_params=law_params, solver=solver, iterPeriod=1,
         history=history, label="notched")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
     O.run(int(nsteps), True)
     t_run = time.perf_counter() - t1
     model = engine.coupled
+    capacity = capacity_record(law, model)
     g = engine.graph
     pos, V, T = g.pos, engine.potential.copy(), engine.temperature.copy()
     sol = engine.solution

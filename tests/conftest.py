@@ -64,14 +64,30 @@ def yade_module():
         _missing(str(exc))
 
 
+#: How the tests start YADE: yade-electro's launcher (YADE's own launcher script without its
+#: remote servers), on Debian's interpreter, with this checkout on PYTHONPATH.
+YADE_COMMAND = ["/usr/bin/python3", "-m", "yade_electro.yade.launcher"]
+
+
+def yade_command():
+    """The command list that runs ``yade`` (without open ports); fails if YADE is missing."""
+    name = os.environ.get("YADE_ELECTRO_YADE", "yade")
+    if shutil.which(name) is None:
+        _missing("YADE launcher %r not found on PATH (Debian package `yade`)" % name)
+    return list(YADE_COMMAND)
+
+
+def repo_env(env=None):
+    """The environment with this checkout first on PYTHONPATH."""
+    run_env = dict(os.environ if env is None else env)
+    run_env["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO_ROOT), run_env.get("PYTHONPATH")) if p)
+    return run_env
+
+
 @pytest.fixture(scope="session")
 def yade_exe():
-    """Path of the ``yade`` launcher (``$YADE_ELECTRO_YADE`` or ``yade`` on PATH)."""
-    name = os.environ.get("YADE_ELECTRO_YADE", "yade")
-    exe = shutil.which(name)
-    if exe is None:
-        _missing("YADE launcher %r not found on PATH (Debian package `yade`)" % name)
-    return exe
+    """The command (a list) that runs YADE's launcher without its remote servers."""
+    return yade_command()
 
 
 @pytest.fixture(scope="session")
@@ -85,7 +101,8 @@ def liggghts_exe():
 
 @pytest.fixture
 def run_yade_script(yade_exe, tmp_path):
-    """Run a script with ``yade -n -x`` in a subprocess; returns a :data:`YadeRun`.
+    """Run a script with ``yade-electro -n -x`` (YADE without its remote servers) in a
+    subprocess; returns a :data:`YadeRun`.
 
     ``run_yade_script(path_or_source, *args, timeout=600, cwd=None, env=None,
     check=False, repo_on_path=True)``
@@ -115,11 +132,8 @@ def run_yade_script(yade_exe, tmp_path):
             counter[0] += 1
             script = tmp_path / ("yade_script_%d.py" % counter[0])
             script.write_text(textwrap.dedent(path_or_source))
-        run_env = dict(os.environ if env is None else env)
-        if repo_on_path:
-            run_env["PYTHONPATH"] = os.pathsep.join(
-                p for p in (str(REPO_ROOT), run_env.get("PYTHONPATH")) if p)
-        cmd = [yade_exe, "-n", "-x", str(script)] + [str(a) for a in args]
+        run_env = repo_env(env) if repo_on_path else dict(os.environ if env is None else env)
+        cmd = yade_exe + ["-n", "-x", str(script)] + [str(a) for a in args]
         proc = subprocess.Popen(cmd, cwd=str(cwd or tmp_path), env=run_env,
                                 stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, start_new_session=True)

@@ -5,7 +5,6 @@ real YADE (Debian package) in a subprocess ``yade -n -x`` or through the import 
 """
 import json
 import os
-import shutil
 import subprocess
 import sys
 import textwrap
@@ -14,6 +13,7 @@ import numpy as np
 import pytest
 
 from yade_electro.yade import packing as P
+from conftest import repo_env  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 YADE_PY = "/usr/lib/x86_64-linux-gnu/yade-double/py"
@@ -165,8 +165,6 @@ def test_bonds_and_statistics(rod):
 # ------------------------------------------------------------------------------------------
 # Real YADE
 # ------------------------------------------------------------------------------------------
-def _yade_exe():
-    return shutil.which("yade")
 
 
 YADE_SCRIPT = textwrap.dedent("""
@@ -212,15 +210,11 @@ YADE_SCRIPT = textwrap.dedent("""
 """)
 
 
-@pytest.mark.yade
-def test_add_bonded_packing_in_yade(tmp_path, rod, cache):
-    exe = _yade_exe()
-    if exe is None:
-        pytest.skip("yade executable not found (install the Debian package yade)")
+def test_add_bonded_packing_in_yade(tmp_path, rod, cache, yade_exe):
     script = tmp_path / "bond.py"
     script.write_text(YADE_SCRIPT.format(root=ROOT, n=N, cache=str(cache)))
-    proc = subprocess.run([exe, "-n", "-x", str(script)], capture_output=True, text=True,
-                          timeout=300, cwd=tmp_path)
+    proc = subprocess.run(yade_exe + ["-n", "-x", str(script)], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path, env=repo_env())
     lines = [l for l in proc.stdout.splitlines() if l.startswith("RESULT ")]
     assert lines, f"yade failed:\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
     out = json.loads(lines[-1][7:])

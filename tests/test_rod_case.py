@@ -19,6 +19,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CASE = os.path.join(ROOT, "cases", "rod_resistance.py")
 sys.path.insert(0, os.path.join(ROOT, "cases"))
 import rod_resistance as rod  # noqa: E402
+from conftest import repo_env  # noqa: E402
 
 
 def test_theory_and_layers():
@@ -48,13 +49,13 @@ def test_rod_1000(run_yade_script, tmp_path, law, low, high):
     assert "error" in res.stdout and "R_th" in res.stdout
 
 
-def test_yade_batch_table(tmp_path):
-    """The sweep through yade-batch: a one-line table, parameters read by readParamsFromTable."""
+def test_yade_batch_table(tmp_path, yade_exe):
+    """The sweep through yade-batch (yade-electro's: no open ports): a one-line table, parameters
+    read by readParamsFromTable."""
     table = tmp_path / "t.table"
     table.write_text("description n seed law\nsmall 600 4 'voronoi'\n")
-    env = dict(os.environ, PYTHONPATH=ROOT)
-    p = subprocess.run(["yade-batch", "--log", str(tmp_path / "@.log"), str(table), CASE], cwd=tmp_path,
-                       env=env, stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=600)
+    p = subprocess.run(yade_exe + ["batch", "--log", str(tmp_path / "@.log"), str(table), CASE], cwd=tmp_path,
+                       env=repo_env(), stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=600)
     logs = list(tmp_path.glob("*.log"))
     text = "".join(f.read_text() for f in logs)
     # yade-batch exits 0 even when a job fails: read the job's status in its log too

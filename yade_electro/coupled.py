@@ -302,6 +302,11 @@ class ElectroThermalModel:
         return self.heat.temperature
 
     @property
+    def graph(self) -> ContactGraph:
+        """The graph of the last step (elements and bonds read from the scene)."""
+        return self.network.graph
+
+    @property
     def capacity(self) -> np.ndarray:
         """Heat capacities C_i of the current graph's elements [J/K]."""
         if self.heat is None:

@@ -196,15 +196,19 @@ class ElectricalModel:
 
     @property
     def graph(self) -> Optional[ContactGraph]:
-        """The network the current flows in: the bond graph's elements with ``network_edges``."""
+        """The network the current flows in: the bond graph's elements and the edges that
+        conduct (``network_edges`` with a non-zero conductance). The solution's arrays
+        (``branch_current``) follow ``network_edges``."""
         if self.problem is None:
             return None
         g = self.bond_graph
-        if self.network.edges is g.edges:
+        conducting = self.network.factor > 0
+        if self.network.edges is g.edges and np.all(conducting):
             return g
-        key = (id(g), id(self.network.edges))
+        key = (id(g), id(self.network.edges), id(self.network.factor))
         if self._graph_view is None or self._graph_view[0] != key:
-            self._graph_view = (key, ContactGraph(g.pos, g.radius, self.network.edges, g.ids, g.revision))
+            self._graph_view = (key, ContactGraph(g.pos, g.radius, self.network.edges[conducting], g.ids,
+                                                  g.revision))
         return self._graph_view[1]
 
     def _rho_edge(self, edges, n):
@@ -267,7 +271,11 @@ class ElectricalModel:
             raise RuntimeError("no graph yet: call solve(graph) first")
         elif self._rho_stale:
             self.update(self.bond_graph)
+        prev = self.solution
         self.solution = self.problem.solve(self.values)
+        # the work of this call (a solution kept from an earlier call cost nothing)
+        self.last_iterations = 0 if self.solution is prev else int(self.solution.info.get("iterations", 0))
+        self.last_solve_time = 0.0 if self.solution is prev else float(self.solution.info.get("basis_time", 0.0))
         return self.solution
 
     def prepare(self, graph: ContactGraph) -> ConductionProblem:
@@ -303,6 +311,6 @@ class ElectricalModel:
         row["n_floating"] = int(sol.floating.sum())
         row["residual"] = sol.residual
         row["current_imbalance"] = sol.current_imbalance
-        row["iterations"] = int(sol.info.get("iterations", 0))
-        row["solve_time"] = float(sol.info.get("basis_time", 0.0))
+        row["iterations"] = self.last_iterations
+        row["solve_time"] = self.last_solve_time
         return row

@@ -121,30 +121,47 @@ def _area(poly, normal):
     return 0.5 * abs(np.cross(q, np.roll(q, -1, axis=0)).sum(axis=0) @ normal)
 
 
-def _clipped_area(poly, normal, container, max_planes=8, rel_tol=1e-2):
+def _tangent_planes(points, d, container, tol):
+    """Tangent planes (feet, unit normals) of the container at the nearest surface points of
+    the ``points`` whose signed distance ``d`` exceeds ``tol``, duplicates merged."""
+    out = d > tol
+    if not np.any(out):
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    p, dd = points[out], d[out]
+    g = np.asarray(container.gradient(p), float)
+    g /= np.linalg.norm(g, axis=1)[:, None]
+    feet = p - dd[:, None] * g
+    key = np.round(np.column_stack([g, np.einsum("ij,ij->i", g, feet) / max(tol, 1e-300)]), 6)
+    _, first = np.unique(key, axis=0, return_index=True)
+    first = np.sort(first)
+    return feet[first], g[first]
+
+
+def _clipped_area(poly, normal, container, max_rounds=8, rel_tol=1e-2):
     """Area of the part of a planar convex polygon inside the container, clipped by the
-    tangent planes at the nearest surface points of the vertices that stick out (exact for
-    planar walls; on curved walls vertices may stay outside by ``rel_tol`` times the
-    polygon's size, a tangent-plane error O(h^2 / R)). A plane that would also remove
-    vertices inside the solid (a re-entrant corner) is not used: the polygon is then
-    measured by sampling."""
+    tangent planes at the nearest surface points of the vertices that stick out, all of a
+    round at once (exact for planar walls; on curved walls vertices may stay outside by
+    ``rel_tol`` times the polygon's size, a tangent-plane error O(h^2 / R)). A plane that
+    would also remove vertices inside the solid (a re-entrant corner) is not used: the
+    polygon is then measured by sampling."""
     poly = _order(poly, normal)
     size = float(np.linalg.norm(poly.max(axis=0) - poly.min(axis=0)))
     tol = rel_tol * size
-    for _ in range(max_planes):
+    for _ in range(max_rounds):
         if len(poly) < 3:
             return 0.0
         d = np.asarray(container.sdf(poly), float)
-        k = int(np.argmax(d))
-        if d[k] <= tol:
+        feet, g = _tangent_planes(poly, d, container, tol)
+        if feet.shape[0] == 0:
             break
-        g = np.asarray(container.gradient(poly[k:k + 1]), float)[0]
-        g /= np.linalg.norm(g)
-        foot = poly[k] - d[k] * g
-        removed = (poly - foot) @ g > 1e-12 * size
-        if np.any(d[removed] < -tol):           # a concave corner: the plane would cut solid
+        # a plane may remove only what is outside the solid (not so at a re-entrant corner)
+        removed = np.einsum("vk,pk->pv", poly, g) - np.einsum("pk,pk->p", feet, g)[:, None] > 1e-12 * size
+        if np.any(removed & (d[None, :] < -tol)):
             return _sampled_area(poly, normal, container)
-        poly = _clip(poly, foot, g)
+        for foot, nrm in zip(feet, g):
+            poly = _clip(poly, foot, nrm)
+            if len(poly) < 3:
+                return 0.0
     return _area(poly, normal)
 
 
@@ -325,34 +342,32 @@ def _interior_point(hs, guess):
     return res.x[:3]
 
 
-def _clipped_volume(hs, guess, container, max_planes, rel_tol):
-    """Volume of the convex polytope ``hs`` inside the container, clipped by tangent planes
-    at the nearest surface points of the vertices that stick out, the farthest one first
-    (exact for planar walls; on curved walls the polytope circumscribes the surface:
-    excess O(h^2 / R))."""
+def _clipped_volume(hs, guess, container, max_rounds, rel_tol):
+    """Volume of the convex polytope ``hs`` inside the container, clipped by the tangent planes
+    at the nearest surface points of the vertices that stick out, all of a round at once
+    (exact for planar walls; on curved walls the polytope circumscribes the surface: excess
+    O(h^2 / R))."""
     from scipy.spatial import ConvexHull, HalfspaceIntersection
-    for _ in range(max_planes + 1):
+    verts = None
+    for _ in range(max_rounds + 1):
         x0 = _interior_point(hs, guess)
         if x0 is None:
             return 0.0
         verts = HalfspaceIntersection(hs, x0).intersections
         d = np.asarray(container.sdf(verts), float)
-        k = int(np.argmax(d))
         size = float(np.linalg.norm(verts.max(axis=0) - verts.min(axis=0)))
-        if d[k] <= rel_tol * size:
+        feet, g = _tangent_planes(verts, d, container, rel_tol * size)
+        if feet.shape[0] == 0:
             break
-        g = np.asarray(container.gradient(verts[k:k + 1]), float)[0]
-        g /= np.linalg.norm(g)
-        foot = verts[k] - d[k] * g
-        # the tangent plane may only remove what is outside the solid: at a re-entrant
-        # (concave) corner it would also cut solid away (even the element's own centre);
+        # the tangent planes may only remove what is outside the solid: at a re-entrant
+        # (concave) corner they would also cut solid away (even the element's own centre);
         # such a cell is measured by sampling instead
-        removed = (verts - foot) @ g > 1e-12 * size
-        if np.any(d[removed] < -rel_tol * size):
+        removed = verts @ g.T - np.einsum("pk,pk->p", feet, g)[None, :] > 1e-12 * size
+        if np.any(removed & (d[:, None] < -rel_tol * size)):
             return _sampled_volume(hs, verts, container)
-        hs = np.vstack([hs, np.append(g, -g @ foot)])
+        hs = np.vstack([hs, np.column_stack([g, -np.einsum("pk,pk->p", g, feet)])])
         if container.sdf(guess[None, :])[0] >= -1e-12 * size:   # centre on the wall: move in
-            guess = guess - 1e-3 * size * g
+            guess = guess - 1e-3 * size * g.mean(axis=0)
     return float(ConvexHull(verts).volume)
 
 
@@ -371,7 +386,7 @@ def _sampled_volume(hs, verts, container, k=24):
     return float(np.prod(hi - lo) * inside.mean())
 
 
-def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: float = 1e-4,
+def voronoi_cell_volumes(pos, radius, container, max_rounds: int = 12, rel_tol: float = 1e-4,
                          return_info: bool = False, tessellation=None):
     """Volumes [m^3] of the Voronoi cells of the element centres, bounded by the container:
     the volume of solid each element stands for (heat capacity ``rho c V_cell``).
@@ -381,9 +396,9 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
     the container are measured exactly, as the pyramids from the centre on the faces
     (sum_j A_ij l_ij / 6). Cells that stick out
     are intersected (``scipy.spatial.HalfspaceIntersection``) with the tangent planes of the
-    container at the nearest surface points of their outside vertices, one plane at a time
-    (at most ``max_planes``) until no vertex is outside by more than ``rel_tol`` times the
-    cell's size. For planar walls this is exact, so the volumes of a packing in a box sum to
+    container at the nearest surface points of their outside vertices, all the planes of a
+    round at once (at most ``max_rounds`` rounds) until no vertex is outside by more than
+    ``rel_tol`` times the cell's size. For planar walls this is exact, so the volumes of a packing in a box sum to
     the box volume to rounding. On a curved wall the clipped cell is bounded by tangent
     planes, i.e. it circumscribes the surface: the sum exceeds the container volume by a
     small relative amount, O((h / R)^2) at most (measured on the rod R = 1 mm, L = 5 mm:
@@ -394,7 +409,7 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
     pos : (n, 3) element centres [m]
     radius : (n,) radii [m] (set the width of the band of mirrored elements)
     container : object with ``sdf`` and ``gradient`` (a shape of ``yade_electro.yade.packing``)
-    max_planes, rel_tol : clipping controls (see above)
+    max_rounds, rel_tol : clipping controls (see above)
     return_info : bool
         Also return a dict: ``total`` (sum of the volumes), ``container_volume`` (exact if
         the container knows it, else None), ``relative_excess`` and ``n_clipped``.
@@ -450,7 +465,7 @@ def voronoi_cell_volumes(pos, radius, container, max_planes: int = 12, rel_tol: 
         ends = np.searchsorted(a, clipped, side="right")
         for i, s, e in zip(clipped, starts, ends):
             hs = _cell_halfspaces(pts, i, b[s:e])
-            vol[i] = _clipped_volume(hs, pos[i].copy(), container, max_planes, rel_tol)
+            vol[i] = _clipped_volume(hs, pos[i].copy(), container, max_rounds, rel_tol)
     if not return_info:
         return vol
     cv = getattr(container, "exact_volume", None)

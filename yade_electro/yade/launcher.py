@@ -1,0 +1,129 @@
+"""``yade-electro``: run YADE scripts and ``yade-batch`` campaigns without YADE's open ports.
+
+Every ``yade script.py`` (also ``yade -n -x``, and every job of ``yade-batch``) starts two
+servers before the script runs (``yade.remote.runServers``): a Python prompt on port 9000 of
+*all* interfaces (although its banner says localhost), guarded by a six-letter cookie drawn
+from one word's letters and printed to the log, and an unauthenticated XMLRPC server on port
+21000. On a shared or cluster node that is a remote Python shell for whoever guesses the
+cookie. YADE skips them only when it is imported as a module or runs under MPI.
+
+This launcher runs Debian's own ``yade`` launcher script, unchanged, in this process, with
+one difference: ``yade.remote.runServers`` does nothing. Everything else (options, the
+script's namespace, ``-x``, ``readParamsFromTable``) is YADE's::
+
+    yade-electro -n -x script.py [args]          # instead of:  yade -n -x script.py [args]
+    yade-electro batch table script.py [opts]    # instead of:  yade-batch table script.py
+
+``batch`` runs ``yade-batch`` with its jobs started by this launcher (``--executable``) and
+without its own HTTP summary server (port 9080 on all interfaces): the jobs' logs are the
+record. ``python3 -m yade_electro.yade.launcher`` is the same command.
+
+Environment: ``YADE_ELECTRO_YADE`` / ``YADE_ELECTRO_YADE_BATCH`` name other YADE launchers.
+"""
+from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import os
+import runpy
+import shutil
+import sys
+
+__all__ = ["main", "disable_remote_servers", "find_launcher"]
+
+NOTICE = "yade-electro: YADE's remote servers (Python prompt :9000, XMLRPC :21000) are not started\n"
+
+
+def _no_servers():
+    sys.stderr.write(NOTICE)
+
+
+class _PatchedLoader(importlib.abc.Loader):
+    def __init__(self, loader):
+        self._loader = loader
+
+    def create_module(self, spec):
+        return self._loader.create_module(spec)
+
+    def exec_module(self, module):
+        self._loader.exec_module(module)
+        module.runServers = _no_servers
+
+
+class _RemoteFinder(importlib.abc.MetaPathFinder):
+    """Finds ``yade.remote`` with the other finders and hands back a loader that replaces its
+    ``runServers`` once the module has run."""
+
+    def find_spec(self, name, path, target=None):
+        if name != "yade.remote":
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(name, path, target)
+        if spec is None or spec.loader is None:
+            return None
+        spec.loader = _PatchedLoader(spec.loader)
+        return spec
+
+
+def disable_remote_servers() -> None:
+    """Make ``yade.remote.runServers`` a no-op in this process (before or after the import)."""
+    mod = sys.modules.get("yade.remote")
+    if mod is not None:
+        mod.runServers = _no_servers
+        return
+    if not any(isinstance(f, _RemoteFinder) for f in sys.meta_path):
+        sys.meta_path.insert(0, _RemoteFinder())
+
+
+def find_launcher(name: str, env: str) -> str:
+    """Path of a YADE launcher script (``yade``, ``yade-batch``)."""
+    exe = os.environ.get(env) or shutil.which(name)
+    if not exe:
+        raise SystemExit(f"yade-electro: {name!r} not found on PATH; install YADE (`make install`, or "
+                         f"`apt-get install yade`) or set {env}")
+    return os.path.realpath(exe)
+
+
+def _disable_batch_http():
+    import http.server
+
+    class NoHTTPServer(http.server.HTTPServer):
+        def __init__(self, *a, **k):
+            raise OSError("yade-electro: yade-batch's HTTP summary server is not started")
+    http.server.HTTPServer = NoHTTPServer
+    sys.stderr.write("yade-electro: yade-batch's HTTP summary server (port 9080) is not started; "
+                     "read the jobs' logs\n")
+
+
+def _self_command() -> str:
+    """The shell command that starts this launcher, for yade-batch's ``--executable``
+    (yade-batch runs its jobs through the shell)."""
+    import shlex
+    return f"{shlex.quote(sys.executable)} -m yade_electro.yade.launcher"
+
+
+def main(argv=None) -> None:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["batch"]:
+        args = argv[1:]
+        if not any(a == "--executable" or a.startswith("--executable=") for a in args):
+            args = ["--executable", _self_command()] + args
+        _disable_batch_http()
+        path = find_launcher("yade-batch", "YADE_ELECTRO_YADE_BATCH")
+        sys.argv = [path] + args
+        _run_as_main(path)
+        return
+    disable_remote_servers()
+    path = find_launcher("yade", "YADE_ELECTRO_YADE")
+    sys.argv = [path] + argv
+    _run_as_main(path)
+
+
+def _run_as_main(path):
+    # YADE evaluates ``__builtins__.name = ...`` in __main__: there __builtins__ must be the
+    # module (as in a real __main__), not the dict exec() would put in
+    import builtins
+    runpy.run_path(path, init_globals={"__builtins__": builtins}, run_name="__main__")
+
+
+if __name__ == "__main__":
+    main()
