@@ -48,12 +48,13 @@ def test_cell_volumes_fill_the_container():
     p = rng.uniform(0, 1, (400, 3)) * [2e-3, 1e-3, 3e-3]
     v, info = voronoi_cell_volumes(p, np.full(len(p), 0.1e-3), box, return_info=True)
     assert np.all(v > 0) and abs(info["relative_excess"]) < 1e-6
-    # curved wall: cells clipped by tangent planes circumscribe it, a small excess
+    # curved wall: cells bounded by tangent planes, the solid they leave out integrated over
+    # them: the volumes fill the cylinder to a few 1e-6 (random points, 800 cells)
     cyl = Cylinder((0, 0, 0), (0, 0, 2e-3), 1e-3)
     q = rng.uniform(-1, 1, (3000, 3)) * [1e-3, 1e-3, 1e-3] + [0, 0, 1e-3]
     q = q[cyl.sdf(q) < -0.02e-3][:800]
     v, info = voronoi_cell_volumes(q, np.full(len(q), 0.05e-3), cyl, return_info=True)
-    assert np.all(v > 0) and 0 <= info["relative_excess"] < 2e-3, info
+    assert np.all(v > 0) and abs(info["relative_excess"]) < 1e-5, info
 
 
 def test_cell_volume_of_is_cached_per_element_set():

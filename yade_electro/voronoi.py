@@ -22,10 +22,12 @@ Units: metres, m^2.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 from scipy.spatial import Voronoi
 
-__all__ = ["voronoi_faces", "ghost_points"]
+__all__ = ["voronoi_faces", "ghost_points", "bounded_cells", "BoundedCells", "VoronoiFaces"]
 
 
 def ghost_points(pos, radius, container=None, band=None, neighbour_barycentre=None, threshold=0.4):
@@ -203,27 +205,322 @@ def _tessellate(pos, radius, ghosts):
     return pts, Voronoi(pts)
 
 
-def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4,
-                  return_tessellation=False):
+@dataclass(frozen=True, eq=False)
+class BoundedCells:
+    """The Voronoi cells of a packing bounded by its container (one tessellation, one pass).
+
+    Attributes
+    ----------
+    pairs : (p, 2) neighbouring elements, i < j
+    area : (p,) area of their common face inside the container [m^2]
+    volume : (n,) volume of each element's cell inside the container [m^3]
+    boundary_owner : (b,) element of each boundary face (a piece of the container's surface
+        that closes a cell)
+    boundary_area : (b,) its area [m^2]
+    boundary_normal : (b, 3) its outward unit normal
+    boundary_point : (b, 3) its centroid [m]
+    n_clipped : cells cut by the container (the others are whole Voronoi cells)
+    n_sampled : cells measured by sampling (re-entrant corners); they have no boundary faces
+    """
+
+    pairs: np.ndarray
+    area: np.ndarray
+    volume: np.ndarray
+    boundary_owner: np.ndarray
+    boundary_area: np.ndarray
+    boundary_normal: np.ndarray
+    boundary_point: np.ndarray
+    n_clipped: int
+    n_sampled: int
+    sampled: np.ndarray = field(default=None, repr=False)
+
+    def boundary_area_of(self, n: int) -> np.ndarray:
+        """Boundary-face area of each of the ``n`` elements [m^2] (0 inside)."""
+        return np.bincount(self.boundary_owner, self.boundary_area, n)
+
+
+def _protrusion_integral(verts, count, centre, container):
+    """Integral of max(sdf, 0) over ordered planar polygons (b, P, 3) [m^3]: fan triangles from
+    ``centre`` (b, 3), the edge-midpoint rule on each (exact for quadratics)."""
+    if verts.shape[0] == 0:
+        return np.zeros(0)
+    b, P, _ = verts.shape
+    valid = np.arange(P)[None, :] < count[:, None]
+    nxt = (np.arange(P)[None, :] + 1) % np.maximum(count, 1)[:, None]
+    vn = np.take_along_axis(verts, nxt[:, :, None], axis=1)
+    c = centre[:, None, :]
+    area = 0.5 * np.linalg.norm(np.cross(verts - c, vn - c), axis=2)
+    m_cv = 0.5 * (c + verts)                      # centre-vertex midpoints (shared by two triangles)
+    m_vv = 0.5 * (verts + vn)                     # edge midpoints
+    d_cv = np.maximum(np.asarray(container.sdf(m_cv.reshape(-1, 3)), float).reshape(b, P), 0.0)
+    d_vv = np.maximum(np.asarray(container.sdf(m_vv.reshape(-1, 3)), float).reshape(b, P), 0.0)
+    d_cn = np.take_along_axis(d_cv, nxt, axis=1)
+    tri = area * (d_cv + d_vv + d_cn) / 3.0
+    return np.where(valid, tri, 0.0).sum(axis=1)
+
+
+def _ridge_polygons(vor, ridges):
+    """Padded vertex arrays (r, P, 3) and counts of Voronoi ridges (unordered vertices)."""
+    rv = [vor.ridge_vertices[k] for k in ridges]
+    count = np.array([len(r) for r in rv], dtype=np.int64)
+    P = int(count.max(initial=3))
+    idx = np.zeros((len(rv), P), dtype=np.int64)
+    for k in np.unique(count):
+        sel = np.flatnonzero(count == k)
+        idx[sel, :k] = np.array([rv[t] for t in sel])
+    return vor.vertices[idx], count
+
+
+def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
+                  planes_per_round: int = 2) -> BoundedCells:
+    """Voronoi cells of the element centres bounded by the container: faces, volumes and
+    boundary faces, from one tessellation (see the module doc for the ghosts).
+
+    Cells with a vertex outside the container by more than ``rel_tol * 2 r_min`` are clipped,
+    all at once (:mod:`yade_electro.clipping`), by the container's tangent planes at the
+    nearest surface points of their outside vertices (the farthest ``planes_per_round``
+    of each cell per round), round after round (at most ``max_rounds``) until no vertex is
+    outside by more than ``rel_tol`` times the cell's size (defaults: 3e-3, 2 planes, 4
+    rounds; the first two rounds clip whatever sticks out by more than 1e-9 of the size, and
+    cells that reach far out take 4x more planes in them).
+    Exact for planar walls. On a curved wall the cell is bounded by tangent planes;
+    the solid they leave out is taken from the volume by integrating the protrusion of the
+    surface over each boundary face (edge-midpoint rule on a fan of triangles, exact for a
+    quadratic surface). Measured on the rod R = 1 mm, L = 5 mm at 5,000 elements: volumes sum
+    to the cylinder's within -4e-7, boundary faces (tangent planes) to its surface within
+    +5e-4, about 1.5 s for faces, volumes and boundary faces together. A plane that would also cut
+    solid away (a re-entrant corner) is not used: such a cell is measured by sampling
+    (:func:`_sampled_volume`, faces by :func:`_clipped_area`) and has no boundary faces.
+
+    Returns
+    -------
+    BoundedCells
+    """
+    from .clipping import FaceSet, clip, concat, face_areas, order_polygons, volumes
+    pos = np.asarray(pos, float)
+    radius = np.asarray(radius, float)
+    n = pos.shape[0]
+    ghosts, _, _, _ = ghost_points(pos, radius, container)
+    pts, vor = _tessellate(pos, radius, ghosts)
+    n_real_and_ghosts = n + ghosts.shape[0]
+    rp = vor.ridge_points
+    tol0 = rel_tol * 2.0 * float(np.min(radius))
+    vout = np.asarray(container.sdf(vor.vertices), float) > tol0
+    flagged = np.zeros(pts.shape[0], bool)
+    for i in range(n):
+        reg = vor.regions[vor.point_region[i]]
+        flagged[i] = (not reg) or (-1 in reg) or bool(vout[reg].any())
+    real_pair = (rp[:, 0] < n) & (rp[:, 1] < n)
+    # --- whole cells: pyramids on their faces, of height l/2 (the face bisects the pair)
+    vol = np.zeros(n)
+    whole = ~flagged
+    sel = np.flatnonzero((whole[rp[:, 0]] & (rp[:, 0] < n)) | (whole[rp[:, 1]] & (rp[:, 1] < n)))
+    dvec = pts[rp[sel, 1]] - pts[rp[sel, 0]]
+    length = np.linalg.norm(dvec, axis=1)
+    a_sel = _polygon_areas(vor.vertices, [vor.ridge_vertices[k] for k in sel], dvec / length[:, None])
+    for side in (0, 1):
+        k = whole[rp[sel, side]] & (rp[sel, side] < n)
+        np.add.at(vol, rp[sel[k], side], a_sel[k] * length[k] / 6.0)
+    # --- faces between real elements: whole where either cell is whole
+    pidx = np.flatnonzero(real_pair)
+    pairs = np.sort(rp[pidx], axis=1)
+    area = np.zeros(pidx.size)
+    pos_of = np.full(rp.shape[0], -1, dtype=np.int64)
+    pos_of[sel] = np.arange(sel.size)
+    plain = ~(flagged[rp[pidx, 0]] & flagged[rp[pidx, 1]])
+    area[plain] = a_sel[pos_of[pidx[plain]]]
+    # --- clipped cells, all at once
+    cells = np.flatnonzero(flagged[:n])
+    b_owner, b_area, b_normal, b_point = (np.zeros(0, np.int64), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
+    sampled = np.zeros(n, bool)
+    if cells.size:
+        local = np.full(pts.shape[0], -1, dtype=np.int64)
+        local[cells] = np.arange(cells.size)
+        rows = np.concatenate([np.flatnonzero(flagged[rp[:, 0]] & (rp[:, 0] < n)),
+                               np.flatnonzero(flagged[rp[:, 1]] & (rp[:, 1] < n))])
+        side = np.concatenate([np.zeros(int((flagged[rp[:, 0]] & (rp[:, 0] < n)).sum()), np.int64),
+                               np.ones(int((flagged[rp[:, 1]] & (rp[:, 1] < n)).sum()), np.int64)])
+        me, other = rp[rows, side], rp[rows, 1 - side]
+        verts, count = _ridge_polygons(vor, rows)
+        nrm = pts[other] - pts[me]
+        nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+        faces = FaceSet(order_polygons(verts, count, nrm), count, local[me], other, nrm)
+        seeds = pos[cells]
+        # each cell's size (its first bounding box): the scale of its tolerances
+        fv0 = faces.verts[np.arange(faces.verts.shape[1])[None, :] < faces.count[:, None]]
+        fo0 = np.repeat(faces.owner, faces.count)
+        srt = np.argsort(fo0, kind="stable")
+        starts = np.searchsorted(fo0[srt], np.arange(cells.size))
+        size = np.linalg.norm(np.maximum.reduceat(fv0[srt], starts) - np.minimum.reduceat(fv0[srt], starts), axis=1)
+        tol_out, tol_in = rel_tol * size, -rel_tol * size
+        active = np.ones(cells.size, bool)
+
+        def vertices_of(mask_cells):
+            """Vertices (flat), their cells and signed distances, of the cells in the mask."""
+            fm = mask_cells[faces.owner]
+            P = faces.verts.shape[1]
+            valid = (np.arange(P)[None, :] < faces.count[fm][:, None])
+            fv = faces.verts[fm][valid]
+            fo = np.repeat(faces.owner[fm], faces.count[fm])
+            return fv, fo, np.asarray(container.sdf(fv), float)
+
+        done = []                                   # faces of the cells that are finished
+        for rnd in range(max_rounds):
+            fv, fo, d = vertices_of(active)
+            # the first two rounds clip whatever sticks out (a planar wall is then cut
+            # exactly: one plane removes all its side); later ones only what is still out
+            # by more than rel_tol (a curved wall; its remainder is integrated below)
+            out = d > (1e-9 * size[fo] if rnd < 2 else tol_out[fo])
+            has_out = np.zeros(cells.size, bool)
+            has_out[fo[out]] = True
+            active &= has_out                       # converged cells stay converged
+            finished = ~active[faces.owner]
+            if np.any(finished):
+                done.append(faces.keep(finished))
+                faces = faces.keep(~finished)
+            if not np.any(out):
+                break
+            # the farthest outside vertices of each cell, one tangent plane each (a polytope
+            # vertex is on several faces: each vertex once)
+            o_idx = np.flatnonzero(out)
+            vkey = np.round(fv[o_idx] / (1e-9 * size[fo[o_idx], None]))
+            _, uniq = np.unique(np.column_stack([fo[o_idx], vkey]), axis=0, return_index=True)
+            o_idx = o_idx[uniq]
+            o_idx = o_idx[np.lexsort((-d[o_idx], fo[o_idx]))]
+            # their tangent planes, each distinct plane once per cell (on a planar wall
+            # every outside vertex gives the wall itself), the farthest first
+            g = np.asarray(container.gradient(fv[o_idx]), float)
+            g /= np.linalg.norm(g, axis=1)[:, None]
+            feet = fv[o_idx] - d[o_idx, None] * g
+            oc = fo[o_idx]
+            pkey = np.column_stack([oc, np.round(g * 1e6), np.round(np.einsum("ij,ij->i", g, feet)
+                                                                   / (1e-7 * size[oc]))])
+            _, uniq = np.unique(pkey, axis=0, return_index=True)
+            uniq = np.sort(uniq)
+            g, feet, oc = g[uniq], feet[uniq], oc[uniq]
+            first = np.r_[True, oc[1:] != oc[:-1]]
+            rank = np.arange(oc.size) - np.maximum.accumulate(np.where(first, np.arange(oc.size), 0))
+            # cells reaching far out of the solid (no ghost closes them: corners, elements
+            # on the wall, concave parts) take up to 4x more planes in the first rounds
+            far = np.zeros(cells.size, bool)
+            far[fo[out][d[out] > 0.05 * size[fo[out]]]] = True
+            limit = 4 * planes_per_round if rnd < 2 else planes_per_round
+            sel_p = rank < np.where(far[oc], limit, planes_per_round)
+            g, feet, towner, rank = g[sel_p], feet[sel_p], oc[sel_p], rank[sel_p]
+            for j in range(limit):
+                sub = rank == j
+                if not np.any(sub):
+                    break
+                pc = towner[sub]
+                point = np.zeros((cells.size, 3))
+                normal = np.zeros((cells.size, 3))
+                point[pc], normal[pc] = feet[sub], g[sub]
+                act = np.zeros(cells.size, bool)
+                act[pc] = True
+                act &= active
+                # a plane may remove only what is outside the solid: at a re-entrant corner
+                # it would cut solid away; such a cell is measured by sampling instead
+                if j:
+                    fv, fo, d = vertices_of(act)
+                chk = act[fo] & (d < tol_in[fo])
+                s_chk = np.einsum("vk,vk->v", fv[chk] - point[fo[chk]], normal[fo[chk]])
+                bad = np.unique(fo[chk][s_chk > 1e-12 * size[fo[chk]]])
+                if bad.size:
+                    sampled[cells[bad]] = True
+                    active[bad] = False
+                    act[bad] = False
+                faces = clip(faces, point, normal, act, size)
+        faces = concat(done + [faces])
+        # results of the clipped cells
+        good = ~sampled[cells]
+        vol_c = volumes(faces, seeds, cells.size)
+        vol[cells[good]] = vol_c[good]
+        fa = face_areas(faces)
+        # boundary faces: caps, and faces towards ghosts (the mirror planes at the wall)
+        capm = ((faces.label < 0) | ((faces.label >= n) & (faces.label < n_real_and_ghosts))) & good[faces.owner]
+        b_owner = cells[faces.owner[capm]]
+        b_area = fa[capm]
+        bn = faces.plane[capm]
+        F, P, _ = faces.verts.shape
+        valid = (np.arange(P)[None, :] < faces.count[:, None])[capm]
+        bp = np.where(valid[:, :, None], faces.verts[capm], 0.0).sum(axis=1) / faces.count[capm][:, None]
+        # the solid that the boundary faces (tangent planes) leave out on a curved wall:
+        # the integral of the protrusion sdf > 0 over each face, by the edge-midpoint rule on
+        # a fan of triangles (exact for a quadratic surface); taken from the cell volumes
+        cutoff = _protrusion_integral(faces.verts[capm], faces.count[capm], bp, container)
+        vol -= np.bincount(b_owner, cutoff, n)
+        # outward: away from the element's centre
+        flip = np.einsum("bk,bk->b", bp - pos[b_owner], bn) < 0
+        bn = np.where(flip[:, None], -bn, bn)
+        b_normal, b_point = bn, bp
+        # clipped copies of the faces between two clipped real cells: the mean of both
+        realf = (faces.label >= 0) & (faces.label < n) & good[faces.owner]
+        own = cells[faces.owner[realf]]
+        oth = faces.label[realf]
+        key = np.minimum(own, oth) * n + np.maximum(own, oth)
+        pkey = pairs[:, 0] * n + pairs[:, 1]
+        order = np.argsort(pkey)
+        at = np.clip(np.searchsorted(pkey[order], key), 0, max(pkey.size - 1, 0))
+        hit = pkey.size > 0
+        if hit:
+            ok = pkey[order][at] == key
+            tgt = order[at[ok]]
+            sums = np.bincount(tgt, fa[realf][ok], pairs.shape[0])
+            cnts = np.bincount(tgt, None, pairs.shape[0])
+            both = ~plain & (cnts > 0)
+            area[both] = sums[both] / cnts[both]
+        # sampled (re-entrant) cells: the per-cell path
+        for i in np.flatnonzero(sampled):
+            nb = np.concatenate([rp[rp[:, 0] == i, 1], rp[rp[:, 1] == i, 0]])
+            hs = _cell_halfspaces(pts, i, nb)
+            vol[i] = _clipped_volume(hs, pos[i].copy(), container, max_rounds, rel_tol)
+        if np.any(sampled):
+            redo = ~plain & (sampled[pairs[:, 0]] | sampled[pairs[:, 1]])
+            for m in np.flatnonzero(redo):
+                r = vor.ridge_vertices[pidx[m]]
+                dn = pts[pairs[m, 1]] - pts[pairs[m, 0]]
+                area[m] = _clipped_area(vor.vertices[r], dn / np.linalg.norm(dn), container)
+    # ghost faces of whole cells
+    gsel = np.flatnonzero(((rp[:, 0] < n) & whole[rp[:, 0]] & (rp[:, 1] >= n) & (rp[:, 1] < n_real_and_ghosts))
+                          | ((rp[:, 1] < n) & whole[rp[:, 1]] & (rp[:, 0] >= n) & (rp[:, 0] < n_real_and_ghosts)))
+    if gsel.size:
+        me = np.where(rp[gsel, 0] < n, rp[gsel, 0], rp[gsel, 1])
+        gh = np.where(rp[gsel, 0] < n, rp[gsel, 1], rp[gsel, 0])
+        gn = pts[gh] - pts[me]
+        gn /= np.linalg.norm(gn, axis=1)[:, None]
+        ga = _polygon_areas(vor.vertices, [vor.ridge_vertices[k] for k in gsel], gn)
+        gp = np.array([vor.vertices[vor.ridge_vertices[k]].mean(axis=0) for k in gsel])
+        b_owner = np.concatenate([b_owner, me])
+        b_area = np.concatenate([b_area, ga])
+        b_normal = np.concatenate([b_normal, gn])
+        b_point = np.concatenate([b_point, gp])
+    keep = area > 0
+    return BoundedCells(pairs=pairs[keep], area=area[keep], volume=vol, boundary_owner=b_owner,
+                        boundary_area=b_area, boundary_normal=b_normal, boundary_point=b_point,
+                        n_clipped=int(cells.size), n_sampled=int(sampled.sum()), sampled=sampled)
+
+
+def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
     """Pairs of neighbouring cells and the areas of their common faces.
 
     Parameters
     ----------
     pos, radius : element centres (n, 3) and radii (n,) [m]
-    container : object with ``sdf`` and ``gradient``, optional (see module doc)
+    container : object with ``sdf`` and ``gradient``, optional (see module doc); with one,
+        the faces are those of :func:`bounded_cells`
     neighbour_barycentre : (n, 3), needed without a container
 
     Returns
     -------
     pairs : (p, 2) int array, i < j, both real elements
     area : (p,) face areas [m^2] (clipped to the container when one is given)
-    tessellation : (points, scipy Voronoi), with ``return_tessellation`` (for
-        :func:`voronoi_cell_volumes`, so one tessellation serves both)
     """
     pos = np.asarray(pos, float)
+    if container is not None:
+        cells = bounded_cells(pos, radius, container)
+        return cells.pairs, cells.area
     n = pos.shape[0]
-    ghosts, foot, nrm, mirrored = ghost_points(pos, radius, container,
-                                               neighbour_barycentre=neighbour_barycentre,
+    ghosts, foot, nrm, mirrored = ghost_points(pos, radius, None, neighbour_barycentre=neighbour_barycentre,
                                                threshold=threshold)
     pts, vor = _tessellate(pos, radius, ghosts)
     rp = vor.ridge_points
@@ -237,20 +534,12 @@ def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, thresh
     d = pts[pairs[:, 1]] - pts[pairs[:, 0]]
     normals = d / np.linalg.norm(d, axis=1)[:, None]
     area = _polygon_areas(vor.vertices, rv, normals)
-    if container is not None:
-        verts_out = np.asarray(container.sdf(vor.vertices)) > 0
-        for m, r in enumerate(rv):
-            if verts_out[r].any():
-                area[m] = _clipped_area(vor.vertices[r], normals[m], container)
-    else:
-        # clip by the tangent planes of the surface elements of each face
-        plane_of = {int(i): (foot[k], nrm[k]) for k, i in enumerate(mirrored)}
-        for m, (i, j) in enumerate(pairs):
-            planes = [plane_of[q] for q in (int(i), int(j)) if q in plane_of]
-            if planes:
-                area[m] = _clipped_by_planes(vor.vertices[rv[m]], normals[m], planes)
-    if return_tessellation:
-        return pairs, area, (pts, vor)
+    # clip by the tangent planes of the surface elements of each face
+    plane_of = {int(i): (foot[k], nrm[k]) for k, i in enumerate(mirrored)}
+    for m, (i, j) in enumerate(pairs):
+        planes = [plane_of[q] for q in (int(i), int(j)) if q in plane_of]
+        if planes:
+            area[m] = _clipped_by_planes(vor.vertices[rv[m]], normals[m], planes)
     return pairs, area
 
 
@@ -271,20 +560,20 @@ class VoronoiFaces:
 
     @classmethod
     def of(cls, graph, container):
-        """Faces of ``graph``'s elements in ``container``; the tessellation is kept so that
-        :meth:`cell_volumes` does not make it again."""
-        pairs, area, tess = voronoi_faces(graph.pos, graph.radius, container, return_tessellation=True)
-        faces = cls(pairs, area, graph.n_nodes)
-        faces._geometry = (graph.pos, graph.radius, container, tess)
+        """Faces of ``graph``'s elements in ``container``, from :func:`bounded_cells` (kept,
+        with the cell volumes and boundary faces of the same pass)."""
+        cells = bounded_cells(graph.pos, graph.radius, container)
+        faces = cls(cells.pairs, cells.area, graph.n_nodes)
+        faces.cells = cells
         return faces
 
+    cells = None
+
     def cell_volumes(self) -> np.ndarray:
-        """Bounded cell volumes [m^3] of the elements (see :func:`voronoi_cell_volumes`),
-        from the kept tessellation; computed once."""
-        if getattr(self, "_volumes", None) is None:
-            pos, radius, container, tess = self._geometry
-            self._volumes = voronoi_cell_volumes(pos, radius, container, tessellation=tess)
-        return self._volumes
+        """Bounded cell volumes [m^3] of the elements (from the same pass as the faces)."""
+        if self.cells is None:
+            raise ValueError("these faces were not made by VoronoiFaces.of: no cell volumes")
+        return self.cells.volume
 
     def area_of(self, edges) -> np.ndarray:
         """Face area of each (i, j) edge; 0 where i and j are not Voronoi neighbours."""
@@ -386,92 +675,43 @@ def _sampled_volume(hs, verts, container, k=24):
     return float(np.prod(hi - lo) * inside.mean())
 
 
-def voronoi_cell_volumes(pos, radius, container, max_rounds: int = 12, rel_tol: float = 1e-4,
-                         return_info: bool = False, tessellation=None):
+def voronoi_cell_volumes(pos, radius, container, rel_tol: float = 3e-3, return_info: bool = False):
     """Volumes [m^3] of the Voronoi cells of the element centres, bounded by the container:
-    the volume of solid each element stands for (heat capacity ``rho c V_cell``).
+    the volume of solid each element stands for (heat capacity ``rho c V_cell``); see
+    :func:`bounded_cells`, which this calls.
 
-    The tessellation is the one of :func:`voronoi_faces` (same ghosts across the tangent
-    planes that support the solid, same far points). Cells whose vertices all lie inside
-    the container are measured exactly, as the pyramids from the centre on the faces
-    (sum_j A_ij l_ij / 6). Cells that stick out
-    are intersected (``scipy.spatial.HalfspaceIntersection``) with the tangent planes of the
-    container at the nearest surface points of their outside vertices, all the planes of a
-    round at once (at most ``max_rounds`` rounds) until no vertex is outside by more than
-    ``rel_tol`` times the cell's size. For planar walls this is exact, so the volumes of a packing in a box sum to
-    the box volume to rounding. On a curved wall the clipped cell is bounded by tangent
-    planes, i.e. it circumscribes the surface: the sum exceeds the container volume by a
-    small relative amount, O((h / R)^2) at most (measured on the rod R = 1 mm, L = 5 mm:
-    +1.0e-4 at 1,000 elements, +3.2e-5 at 5,000; see ``return_info``).
+    For planar walls the volumes are exact, so the volumes of a packing in a box sum to the
+    box volume to rounding. On a curved wall the cells are bounded by tangent planes, and
+    the solid those planes leave out is taken away by integrating the protrusion of the
+    surface over them (exact for quadratic surfaces): measured on the rod R = 1 mm, L = 5 mm,
+    the volumes sum to the cylinder's within -4e-7 at 5,000 elements.
 
     Parameters
     ----------
     pos : (n, 3) element centres [m]
     radius : (n,) radii [m] (set the width of the band of mirrored elements)
-    container : object with ``sdf`` and ``gradient`` (a shape of ``yade_electro.yade.packing``)
-    max_rounds, rel_tol : clipping controls (see above)
+    container : object with ``sdf`` and ``gradient`` (a :mod:`yade_electro.geometry` shape)
+    rel_tol : clipping tolerance (see :func:`bounded_cells`)
     return_info : bool
         Also return a dict: ``total`` (sum of the volumes), ``container_volume`` (exact if
         the container knows it, else None), ``relative_excess`` and ``n_clipped``.
-    tessellation : (points, scipy Voronoi), optional
-        The one :func:`voronoi_faces` made for the same elements and container (its
-        ``return_tessellation``), to avoid making it twice.
 
     Returns
     -------
     volumes : (n,) [m^3] (and ``info`` with ``return_info``)
     """
-    pos = np.asarray(pos, float)
-    radius = np.asarray(radius, float)
-    n = pos.shape[0]
     if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
         raise ValueError("voronoi_cell_volumes needs container=<the solid's shape>, an object with sdf(x) "
                          f"and gradient(x); got {container!r}")
-    if tessellation is None:
-        ghosts, _, _, _ = ghost_points(pos, radius, container)
-        pts, vor = _tessellate(pos, radius, ghosts)
-    else:
-        pts, vor = tessellation
-    out = np.asarray(container.sdf(vor.vertices), float) > rel_tol * 2.0 * float(np.min(radius))
-    rp = vor.ridge_points
-    vol = np.zeros(n)
-    inside = np.zeros(pts.shape[0], bool)
-    for i in range(n):
-        reg = vor.regions[vor.point_region[i]]
-        inside[i] = bool(reg) and -1 not in reg and not out[reg].any()
-    clipped = np.flatnonzero(~inside[:n]).tolist()
-    # cells inside the container: the pyramids from the centre on the faces, of height
-    # l_ij / 2 (a Voronoi face is the perpendicular bisector): V_i = sum_j A_ij l_ij / 6
-    sel = np.flatnonzero(inside[rp[:, 0]] | inside[rp[:, 1]])
-    rv = [vor.ridge_vertices[k] for k in sel]
-    dvec = pts[rp[sel, 1]] - pts[rp[sel, 0]]
-    length = np.linalg.norm(dvec, axis=1)
-    area = _polygon_areas(vor.vertices, rv, dvec / length[:, None])
-    pyramid = area * length / 6.0
-    for side in (0, 1):
-        k = inside[rp[sel, side]]
-        np.add.at(vol, rp[sel[k], side], pyramid[k])
-    if clipped:
-        # neighbours of every clipped cell, from the ridges
-        cl = np.zeros(pts.shape[0], bool)
-        cl[clipped] = True
-        a = np.concatenate([rp[:, 0], rp[:, 1]])
-        b = np.concatenate([rp[:, 1], rp[:, 0]])
-        sel = cl[a]
-        a, b = a[sel], b[sel]
-        order = np.argsort(a, kind="stable")
-        a, b = a[order], b[order]
-        starts = np.searchsorted(a, clipped)
-        ends = np.searchsorted(a, clipped, side="right")
-        for i, s, e in zip(clipped, starts, ends):
-            hs = _cell_halfspaces(pts, i, b[s:e])
-            vol[i] = _clipped_volume(hs, pos[i].copy(), container, max_rounds, rel_tol)
+    cells = bounded_cells(pos, radius, container, rel_tol=rel_tol)
+    vol = cells.volume
     if not return_info:
         return vol
     cv = getattr(container, "exact_volume", None)
     total = float(vol.sum())
     return vol, {"total": total, "container_volume": cv,
-                 "relative_excess": (total / cv - 1.0) if cv else None, "n_clipped": len(clipped)}
+                 "relative_excess": (total / cv - 1.0) if cv else None, "n_clipped": cells.n_clipped,
+                 "n_sampled": cells.n_sampled}
 
 
 def cell_volume_of(container, **kwargs):
