@@ -495,8 +495,9 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
         b_normal = np.concatenate([b_normal, gn])
         b_point = np.concatenate([b_point, gp])
     keep = area > 0
-    return BoundedCells(pairs=pairs[keep], area=area[keep], volume=vol, boundary_owner=b_owner,
-                        boundary_area=b_area, boundary_normal=b_normal, boundary_point=b_point,
+    bk = b_area > 0
+    return BoundedCells(pairs=pairs[keep], area=area[keep], volume=vol, boundary_owner=b_owner[bk],
+                        boundary_area=b_area[bk], boundary_normal=b_normal[bk], boundary_point=b_point[bk],
                         n_clipped=int(cells.size), n_sampled=int(sampled.sum()), sampled=sampled)
 
 
