@@ -132,7 +132,8 @@ sys.exit(0 if ok else 1)
 EOF
 }
 # from / so that the checkout in the current directory does not count as installed
-if ! assumed_missing yade-electro && (cd / && PYTHONPATH='' editable_ok); then
+# the launcher (console script) comes with the editable install: reinstall when it is missing
+if ! assumed_missing yade-electro && (cd / && PYTHONPATH='' editable_ok) && command -v yade-electro >/dev/null 2>&1; then
   say "yade-electro: editable install points at $ROOT"
 else
   say "yade-electro: installing $ROOT (editable) into $PY"
@@ -163,5 +164,6 @@ print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; yade_
          importlib.util.find_spec("yade_electro").origin))
 EOF
 command -v yade >/dev/null 2>&1 || die "yade not on PATH after installing the Debian package"
+command -v yade-electro >/dev/null 2>&1 || die "yade-electro (the launcher without open ports) not on PATH after the install"
 command -v liggghts >/dev/null 2>&1 || die "liggghts not on PATH after installing the Debian package"
 say "done"

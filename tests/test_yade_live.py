@@ -1,0 +1,353 @@
+"""Live runs in real YADE: save / load (same and new process) continuing exactly, several
+engines, every setup error raised in the script, cheap change detection, and no open port."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+ROD = r'''
+import json, sys, os
+import numpy as np
+from yade import pack, utils
+from yade_electro.yade import ElectroThermalEngine, ElectricalEngine, attach
+from yade_electro.yade import packing as P
+from yade_electro.thermal import FixedTemperature, Convection
+L, RAD = 2e-3, 0.5e-3
+shape = pack.inCylinder((0, 0, 0), (0, 0, L), RAD)
+def stretch():
+    # the rod strains as it heats: positions a function of the iteration (YADE's own
+    # save/load does not restore its dynamics bit for bit, so they are set, not integrated)
+    f = 1.0 + 1e-4 * O.iter / 300.0
+    for b in O.bodies:
+        p = b.state.refPos
+        b.state.pos = (p[0], p[1], p[2] * f)
+def build(n=400):
+    O.reset()
+    pk = P.dense_packing(shape, n=n, seed=3)
+    ids = np.asarray(P.add_bonded_packing(pk))
+    r = float(np.mean(pk.radii))
+    z = pk.centers[:, 2]
+    top, bottom = ids[z > L - 1.5 * r], ids[z < 1.5 * r]
+    utils.setRefSe3()
+    for e in O.engines:
+        if type(e).__name__ == "NewtonIntegrator":
+            e.dead = True
+    O.engines = O.engines + [PyRunner(command="stretch()", iterPeriod=1, label="stretcher")]
+    return ids, top, bottom
+def thermal(top, bottom, **kw):
+    e = ElectroThermalEngine(
+        resistivity=7.3e-7, electrodes={"top": dict(select=top, potential=0.2), "bottom": dict(select=bottom, potential=0.0)},
+        density=7900.0, specific_heat=500.0, conductivity=16.2, temperature=300.0, beta=1e-3,
+        theta="backward-euler", thermal_dt=2e-4, iterPeriod=5, geometry_every=1, move_tolerance=0.0,
+        convection=[Convection("air", shape, h=50.0, t_inf=300.0)], **kw)
+    O.engines = O.engines + [e.runner]
+    return e
+def figures(e):
+    return dict(T={str(k): v for k, v in e.temperature_by_id.items()}, time=e.coupled.time,
+                rows=len(e.history), last=e.history.rows[-1], iter=O.iter,
+                body_T={str(i): O.bodies[int(i)].state.temp for i in e.body_ids[:50]})
+'''
+
+UNINTERRUPTED = ROD + r'''
+ids, top, bottom = build()
+e = thermal(top, bottom, history="h.csv")
+O.run(300, True)
+print(json.dumps(figures(e)))
+'''
+
+SAVE = ROD + r'''
+ids, top, bottom = build()
+e = thermal(top, bottom, history="h.csv")
+O.run(150, True)
+O.save("scene.yade.gz")
+print(json.dumps(figures(e)))
+'''
+
+LOAD_NEW_PROCESS = ROD + r'''
+O.load("scene.yade.gz")
+e = attach("electrothermal")            # the one line after O.load
+O.run(150, True)
+print(json.dumps(figures(e)))
+'''
+
+LOAD_SAME_PROCESS = ROD + r'''
+ids, top, bottom = build()
+e = thermal(top, bottom, history="h.csv")
+O.run(150, True)
+O.save("scene.yade.gz")
+O.run(50, True)                         # the run goes on, then the user goes back to the save
+rows_before = len(e.history)
+O.load("scene.yade.gz")
+O.run(150, True)                        # the saved PyRunner finds the engine and re-attaches it
+out = figures(e)
+out["rows_before_load"] = rows_before
+out["sidecar"] = os.path.exists("h.csv.after-save.csv")
+print(json.dumps(out))
+'''
+
+
+def _csv_rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _compare(a, b, rel=1e-9):
+    ta = np.array([a["T"][k] for k in sorted(a["T"])])
+    tb = np.array([b["T"][k] for k in sorted(a["T"])])
+    assert sorted(a["T"]) == sorted(b["T"])
+    dT = ta - 300.0
+    assert np.max(np.abs(tb - ta)) <= rel * np.max(np.abs(dT)), np.max(np.abs(tb - ta))
+    assert b["time"] == pytest.approx(a["time"], rel=1e-12)
+    for k in ("R_eq", "joule_energy", "heat_content", "convection_heat", "T_mean"):
+        assert b["last"][k] == pytest.approx(a["last"][k], rel=rel), k
+
+
+def test_save_and_load_in_a_new_process_continues_exactly(run_yade_script, tmp_path):
+    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
+    ref_dir.mkdir(), run_dir.mkdir()
+    ref = run_yade_script(UNINTERRUPTED, cwd=ref_dir, check=True).result
+    saved = run_yade_script(SAVE, cwd=run_dir, check=True).result
+    res = run_yade_script(LOAD_NEW_PROCESS, cwd=run_dir, check=True)
+    out = res.result
+    assert ref["T"] and max(v for v in ref["T"].values()) > 300.1          # it heated
+    assert saved["rows"] < out["rows"] == ref["rows"]
+    _compare(ref, out)
+    # temperatures on the bodies are the engine's
+    for k, v in out["body_T"].items():
+        assert v == out["T"][k]
+    # the history CSV was appended, not truncated, and equals the uninterrupted one
+    a, b = _csv_rows(ref_dir / "h.csv"), _csv_rows(run_dir / "h.csv")
+    assert len(a) == len(b) == ref["rows"]
+    for ra, rb in zip(a, b):
+        assert int(ra["iter"]) == int(rb["iter"])
+        assert float(rb["T_max"]) == pytest.approx(float(ra["T_max"]), rel=1e-9)
+
+
+def test_load_in_the_same_process_reattaches(run_yade_script, tmp_path):
+    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
+    ref_dir.mkdir(), run_dir.mkdir()
+    ref = run_yade_script(UNINTERRUPTED, cwd=ref_dir, check=True).result
+    res = run_yade_script(LOAD_SAME_PROCESS, cwd=run_dir, check=True)
+    out = res.result
+    _compare(ref, out)
+    assert out["rows"] == ref["rows"] and out["rows_before_load"] == ref["rows"] - 30 + 10
+    assert out["sidecar"]                 # the rows written after the save are kept aside
+    assert "continuing from the state it saved" in res.stderr
+
+
+SEVERAL = r'''
+import json, warnings
+import numpy as np
+from yade import pack
+from yade_electro.yade import ElectricalEngine, ENGINES
+from yade_electro.yade import packing as P
+pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+el = lambda v: {"top": dict(select=ids[z > z.max() - 1e-4], potential=v), "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)}
+out = {}
+a = ElectricalEngine(resistivity=1e-6, electrodes=el(1.0), history="a.csv")
+b = ElectricalEngine(resistivity=2e-6, electrodes=el(1.0), history="b.csv", write_back="potential_b")
+out["labels"] = [a.label, b.label]
+for kw, key in ((dict(label="electro", history="c.csv"), "explicit_taken"),
+                (dict(history="a.csv", label="third"), "shared_history")):
+    try:
+        ElectricalEngine(resistivity=1e-6, electrodes=el(1.0), **kw)
+    except Exception as exc:
+        out[key] = [type(exc).__name__, str(exc)]
+with warnings.catch_warnings(record=True) as w:
+    warnings.simplefilter("always")
+    c = ElectricalEngine(resistivity=3e-6, electrodes=el(1.0), label="third", history="c.csv")
+    out["shared_attribute_warning"] = [str(x.message) for x in w if "both write" in str(x.message)]
+O.engines = O.engines + [a.runner, b.runner, c.runner]
+O.run(4, True)
+out["rows"] = [len(a.history), len(b.history), len(c.history)]
+out["R"] = [a.equivalent_resistance, b.equivalent_resistance, c.equivalent_resistance]
+out["registry"] = sorted(ENGINES)
+print(json.dumps(out))
+'''
+
+
+def test_several_engines(run_yade_script):
+    out = run_yade_script(SEVERAL, check=True).result
+    assert out["labels"] == ["electro", "electro_2"]
+    assert out["explicit_taken"][0] == "ValueError" and "already running" in out["explicit_taken"][1]
+    assert out["shared_history"][0] == "ValueError" and "already writes the history file" in out["shared_history"][1]
+    assert len(out["shared_attribute_warning"]) == 1 and "b.potential" in out["shared_attribute_warning"][0]
+    assert all(n >= 3 for n in out["rows"])                  # each engine ran its own model
+    Ra, Rb, Rc = out["R"]
+    assert Rb == pytest.approx(2 * Ra, rel=1e-9) and Rc == pytest.approx(3 * Ra, rel=1e-9)
+    assert out["registry"] == ["electro", "electro_2", "third"]
+
+
+SETUP_ERRORS = r'''
+import json
+import numpy as np
+from yade import pack
+from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
+from yade_electro.thermal import FixedTemperature, Convection, HeatFlux
+from yade_electro.yade import packing as P
+pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+EL = {"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0), "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)}
+TH = dict(density=7900.0, specific_heat=500.0, conductivity=16.0, temperature=300.0)
+nowhere = pack.inAlignedBox((1, 1, 1), (2, 2, 2))
+cases = {   # keyword arguments, made when the case runs (a boundary condition checks itself when made)
+  "density 0": lambda: dict(density=0.0), "density negative": lambda: dict(density=-1.0),
+  "density NaN": lambda: dict(density=float("nan")), "density string": lambda: dict(density="7900"),
+  "conductivity string": lambda: dict(conductivity="x"), "specific_heat 0": lambda: dict(specific_heat=0.0),
+  "theta": lambda: dict(theta="rk4"), "theta number": lambda: dict(theta=2.0),
+  "fixed selects nothing": lambda: dict(fixed=[FixedTemperature("hot", nowhere, 400.0)]),
+  "fixed overlap": lambda: dict(fixed=[FixedTemperature("a", ids[:20], 400.0), FixedTemperature("b", ids[10:30], 300.0)]),
+  "convection bad area": lambda: dict(convection=[Convection("air", ids[:5], h=10.0, t_inf=300.0, area=-1.0)]),
+  "flux not a BC": lambda: dict(flux=["hot"]),
+  "thermal_dt": lambda: dict(thermal_dt=-1.0),
+}
+out = {}
+def record(name, fn):
+    try:
+        fn()
+        out[name] = None
+    except Exception as exc:
+        out[name] = [type(exc).__name__, [c.__name__ for c in type(exc).__mro__], str(exc)]
+for name, kw in cases.items():
+    record(name, lambda kw=kw: ElectroThermalEngine(resistivity=1e-6, electrodes=EL, **{**TH, **kw()}))
+record("iterPeriod 0", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, iterPeriod=0))
+record("iterPeriod float", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, iterPeriod=2.5))
+record("label", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, label="my engine"))
+record("write_back read-only", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="id"))
+record("write_back YADE's", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="dynamic"))
+record("write_back not a name", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="a.b"))
+record("selector float", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=3.7, potential=1.0)}))
+record("selector floats", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=[1.5, 2.7], potential=1.0)}))
+record("value string", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=EL["top"]["select"], potential="1V")}))
+record("value NaN", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=EL["top"]["select"], current=float("nan"))}))
+record("resistivity string", lambda: ElectricalEngine(resistivity="1e-6", electrodes=EL))
+record("electrode selects nothing", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=nowhere, potential=1.0)}))
+print(json.dumps(out))
+'''
+
+EXPECTED = {
+    "density 0": ("MaterialError", "density"), "density negative": ("MaterialError", "density"),
+    "density NaN": ("MaterialError", "density"), "density string": ("MaterialError", "density"),
+    "conductivity string": ("MaterialError", "conductivity"), "specific_heat 0": ("MaterialError", "specific_heat"),
+    "theta": ("ValueError", "unknown integrator"), "theta number": ("ValueError", "theta must be in [0, 1]"),
+    "fixed selects nothing": ("BoundaryConditionError", "thermal boundary condition 'hot' selects no element"),
+    "fixed overlap": ("BoundaryConditionError", "fixed-temperature boundary conditions 'a' and 'b'"),
+    "convection bad area": ("BoundaryConditionError", "convection boundary condition 'air': areas must be finite"),
+    "flux not a BC": ("TypeError", "HeatFlux"),
+    "thermal_dt": ("ValueError", "thermal_dt must be > 0"),
+    "iterPeriod 0": ("ValueError", "iterPeriod must be an integer >= 1"),
+    "iterPeriod float": ("ValueError", "iterPeriod must be an integer >= 1"),
+    "label": ("ValueError", "label must be a Python identifier"),
+    "write_back read-only": ("ValueError", "write_back='id'"),
+    "write_back YADE's": ("ValueError", "attribute of YADE's Body"),
+    "write_back not a name": ("ValueError", "write_back must be an attribute name"),
+    "selector float": ("BoundaryConditionError", "body ids must be integers"),
+    "selector floats": ("BoundaryConditionError", "body ids must be integers, got [1.5, 2.7]"),
+    "value string": ("BoundaryConditionError", "electrode 'top': value must be a real number"),
+    "value NaN": ("BoundaryConditionError", "electrode 'top': value must be finite"),
+    "resistivity string": ("MaterialError", "resistivity"),
+    "electrode selects nothing": ("BoundaryConditionError", "electrode 'top' selects no element"),
+}
+
+
+def test_every_setup_error_is_raised_in_the_script(run_yade_script):
+    out = run_yade_script(SETUP_ERRORS, check=True).result
+    for case, (name, text) in EXPECTED.items():
+        got = out[case]
+        assert got is not None, f"{case}: accepted"
+        assert got[0] == name and text in got[2], (case, got)
+    # errors of bad values are ValueErrors too (a user's `except ValueError` catches them)
+    for case in ("density 0", "fixed selects nothing", "value string"):
+        assert "ValueError" in out[case][1]
+
+
+DETECTION = r'''
+import json
+import numpy as np
+from yade import pack
+from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import packing as P
+pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+extra = O.bodies.append(sphere((5e-3, 5e-3, 5e-3), 1e-4))   # an unbonded sphere far away
+e = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
+                                                  "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
+                     geometry_every=0, sweep_calls=4)
+out = {"mode": e.reader.bond_mode}
+e.step(); out["reads0"] = e.reader.full_reads
+e.step(); out["reads_unchanged"] = e.reader.full_reads
+O.bodies[extra].shape.radius = 2e-4                        # a radius change
+e.step(); out["after_radius"] = [e.reader.full_reads, e.reader.last_change]
+O.bodies.erase(extra)                                     # an unbonded body erased
+e.step(); out["after_erase"] = [e.reader.full_reads, e.reader.last_change, int(e.bond_graph.n_nodes)]
+# a bond broken in shear with its spheres still in contact: no counter changes, the sweep finds it
+mid = [i for i in O.interactions if i.isReal and abs(O.bodies[i.id1].state.pos[2] - 1e-3) < 2e-4][0]
+mid.phys.cohesionBroken = True
+calls = 0
+while e.reader.last_change != "a bond broke" and calls < 10:
+    e.step(); calls += 1
+out["sweep_calls_to_find"] = calls
+out["edges"] = int(e.bond_graph.n_edges)
+O.bodies[int(ids[0])].shape.radius = -1e-5               # a negative radius: refused
+try:
+    e.step()
+except Exception as exc:
+    out["negative_radius"] = [type(exc).__name__, str(exc)]
+print(json.dumps(out))
+'''
+
+
+def test_cheap_change_detection(run_yade_script):
+    out = run_yade_script(DETECTION, check=True).result
+    assert out["mode"] == "sweep"
+    assert out["reads0"] == out["reads_unchanged"] == 1
+    assert out["after_radius"][0] == 2 and "sphere volume" in out["after_radius"][1]
+    assert out["after_erase"][0] == 3 and "sphere volume" in out["after_erase"][1]
+    assert 1 <= out["sweep_calls_to_find"] <= 4                 # within sweep_calls
+    assert out["negative_radius"][0] == "GraphError" and "radius must be finite and > 0" in out["negative_radius"][1]
+
+
+PORTS = r'''
+import json, os
+import numpy as np
+from yade import pack
+from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import packing as P
+
+def listening():
+    socks = set()
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            t = os.readlink(f"/proc/self/fd/{fd}")
+        except OSError:
+            continue
+        if t.startswith("socket:["):
+            socks.add(t[8:-1])
+    n = 0
+    for f in ("/proc/net/tcp", "/proc/net/tcp6"):
+        for line in open(f).read().splitlines()[1:]:
+            p = line.split()
+            if p[3] == "0A" and p[9] in socks:
+                n += 1
+    return n
+pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+e = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
+                                                  "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)})
+seen = []
+O.engines = O.engines + [e.runner, PyRunner(command="seen.append(listening())", iterPeriod=1)]
+O.run(5, True)
+print(json.dumps({"listening_during_run": max(seen), "checks": len(seen)}))
+'''
+
+
+def test_no_port_is_listening_during_a_run(run_yade_script):
+    res = run_yade_script(PORTS, check=True)
+    assert res.result["checks"] >= 4 and res.result["listening_during_run"] == 0
+    assert "remote servers" in res.stderr and "auth cookie" not in res.stdout + res.stderr
