@@ -1,6 +1,6 @@
 # yade-electro. Everything runs on Debian's /usr/bin/python3, the interpreter YADE is built for.
 PY ?= /usr/bin/python3
-YADE ?= yade
+YADE ?= yade-electro
 PYTEST = $(PY) -m pytest -q -ra
 # pytest exits 5 when it collected no test: that must not pass silently.
 NO_TESTS = { echo "error: pytest collected no tests (exit 5); check tests/ and the -m filter" >&2; exit 1; }

@@ -8,21 +8,22 @@ Joule-rod case's thermal step), 304L, 1 V between the end layers, law 'continuum
 * ``be_unchanged`` / ``explicit_unchanged``: constant resistivity and an unchanged graph,
   so the potential of the first step is re-used; backward Euler (the factorisation is kept)
   or explicit sub-cycled to the stable step (the number of sub-steps is printed);
-* ``be_rho_T`` / ``explicit_rho_T``: rho_e(T) with beta = 1e-3 /K, so conductances,
-  Kirchhoff system and potential are re-solved every step (warm-started CG);
+* ``be_rho_T`` / ``explicit_rho_T``: rho_e(T) with beta = 1e-3 /K: conductances updated in
+  place every step, the potential re-solved warm with the kept solver setup;
+* ``rho_T_step_ratio`` (and ``_voronoi``): one backward-Euler step with beta = 1e-3 over one
+  with beta = 0, same packing, the two models stepped in turn (target <= 1.5);
 * ``*_first``: the first step (assembly, potential solve, capacities, factorisation);
 * ``engine_call``: the whole PyRunner call of an ``ElectroThermalEngine`` (scene read with
   the unchanged-graph check, coupled step, temperatures written to ``b.state.temp`` and
   potentials to ``b.potential``, history row), backward Euler, constant resistivity;
 * ``engine_scene_read``: the scene-read part of that call (bond flags and positions);
-* ``engine_call_count_check``: the whole call with ``bond_check='count'`` and
-  ``geometry_every=0`` (the scene check compares counts only);
 * ``yade_step``: one ``O.step()`` of YADE's mechanics on the same bonded packing, without
   the engine.
 
-Times are the best of ``--repeat`` (default 5), in ms. Ends with one JSON line.
+Times are the best of ``--repeat`` (default 5), in ms; the voronoi law's figures end in
+``_voronoi``. Ends with one JSON line.
 
-    yade -n -x bench/bench_coupled.py [--sizes 5000,20000] [--repeat 5]
+    yade-electro -n -x bench/bench_coupled.py [--sizes 5000,20000] [--repeat 5]
 """
 from __future__ import annotations
 
@@ -48,6 +49,7 @@ def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade_electro.coupled import ElectroThermalModel
     from yade_electro.electrical import ElectricalModel
+    from yade_electro.geometry import Cylinder
     from yade_electro.yade import ElectroThermalEngine, SceneReader
     import joule_rod as jr
     import rod_resistance as rod
@@ -57,27 +59,42 @@ def bench_size(n, repeat=5, seed=1):
     out = {"n": int(graph.n_nodes), "n_edges": int(graph.n_edges)}
     electrodes = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
                   "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
+    container = Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)
 
-    def model(theta, beta):
-        el = ElectricalModel(rod.RHO_304L, electrodes)
+    def model(theta, beta, law="continuum"):
+        el = ElectricalModel(rod.RHO_304L, electrodes, law=law,
+                             law_params={"container": container} if law == "voronoi" else None)
         return ElectroThermalModel(el, jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, beta=beta,
                                    theta=theta)
 
-    for tag, theta in (("be", "backward-euler"), ("explicit", "explicit")):
-        for var, beta in (("unchanged", 0.0), ("rho_T", BETA)):
-            firsts = []
-            for _ in range(max(1, repeat // 2)):
-                m = model(theta, beta)
+    for law in ("continuum", "voronoi"):
+        suffix = "" if law == "continuum" else "_voronoi"
+        for tag, theta in (("be", "backward-euler"), ("explicit", "explicit")):
+            if law == "voronoi" and tag == "explicit":
+                continue
+            models = {}
+            for var, beta in (("unchanged", 0.0), ("rho_T", BETA)):
                 t = time.perf_counter()
-                row = m.step(graph, DT)
-                firsts.append(time.perf_counter() - t)
-            out[f"{tag}_{var}_first_ms"] = min(firsts)
-            m.step(graph, DT)
-            solves = m.n_potential_solves
-            out[f"{tag}_{var}_ms"], row = best(lambda: m.step(graph, DT), repeat)
-            out[f"{tag}_{var}_potential_solves_per_step"] = (m.n_potential_solves - solves) / repeat
-            out[f"{tag}_{var}_substeps"] = int(row["n_substeps"])
-    out["dt_critical_ms"] = m.time_steps()["critical"] * 1e3
+                m = model(theta, beta, law)
+                m.step(graph, DT)
+                out[f"{tag}_{var}_first_ms{suffix}"] = time.perf_counter() - t
+                m.step(graph, DT)
+                models[var] = m
+            # interleaved: one step of each in turn, best of repeat
+            times = {var: [] for var in models}
+            solves0 = {var: m.n_potential_solves for var, m in models.items()}
+            for _ in range(repeat):
+                for var, m in models.items():
+                    t = time.perf_counter()
+                    row = m.step(graph, DT)
+                    times[var].append(time.perf_counter() - t)
+                    out[f"{tag}_{var}_substeps{suffix}"] = int(row["n_substeps"])
+            for var, m in models.items():
+                out[f"{tag}_{var}_ms{suffix}"] = min(times[var])
+                out[f"{tag}_{var}_potential_solves_per_step{suffix}"] = (m.n_potential_solves - solves0[var]) / repeat
+            if tag == "be":
+                out[f"rho_T_step_ratio{suffix}"] = round(min(times["rho_T"]) / min(times["unchanged"]), 3)
+    out["dt_critical_ms"] = models["unchanged"].time_steps()["critical"] * 1e3
 
     # the engine's whole PyRunner call
     engine = ElectroThermalEngine(rod.RHO_304L, {"top": dict(select=ids[top], potential=1.0),
@@ -90,16 +107,6 @@ def bench_size(n, repeat=5, seed=1):
     engine.step()
     out["engine_call_ms"], _ = best(engine.step, repeat)
     out["engine_scene_read_ms"], _ = best(engine.reader.read, repeat)     # part of the call
-    engine.remove()
-    # the same with the cheapest unchanged-scene check (counts only, positions not re-read)
-    engine = ElectroThermalEngine(rod.RHO_304L, {"top": dict(select=ids[top], potential=1.0),
-                                                 "bottom": dict(select=ids[bottom], potential=0.0)},
-                                  jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, thermal_dt=DT,
-                                  theta="backward-euler", geometry_every=0, bond_check="count",
-                                  label="bench_coupled_count")
-    engine.step()
-    engine.step()
-    out["engine_call_count_check_ms"], _ = best(engine.step, repeat)
     engine.remove()
 
     O.dt = 0.5 * yade.utils.PWaveTimeStep()

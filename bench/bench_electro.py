@@ -5,7 +5,7 @@ assembly (conductances + reduced Kirchhoff system), solve time cold (first solve
 setup included) and re-solve with an unchanged graph, for each solver, and the time of one
 YADE mechanical step on the same bonded packing. Ends with one JSON line.
 
-    yade -n -x bench/bench_electro.py [--sizes 5000,20000] [--repeat 5]
+    yade-electro -n -x bench/bench_electro.py [--sizes 5000,20000] [--repeat 5]
 """
 from __future__ import annotations
 

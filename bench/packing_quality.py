@@ -2,12 +2,12 @@
 
 Rod: radius 1 mm, length 5 mm along z. For every N: placement (numpy/scipy, cached),
 statistics of the bonds YADE would create for several detection factors, and, when YADE is
-available (``yade -n -x`` or /usr/bin/python3 with the Debian package), the real bonding
+available (``yade-electro -n -x`` or /usr/bin/python3 with the Debian package), the real bonding
 with :func:`add_bonded_packing` to check that YADE creates exactly those bonds.
 
 Usage::
 
-    yade -n -x bench/packing_quality.py --n 5000
+    yade-electro -n -x bench/packing_quality.py --n 5000
     /usr/bin/python3 bench/packing_quality.py --n 1000 2000 5000 --plots docs/img --no-cache
 
 Prints a table and one JSON line (prefix ``JSON``) with all figures.

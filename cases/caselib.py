@@ -1,4 +1,4 @@
-"""Pieces every case script shares: yade-batch parameters and gathering per-run results.
+"""Pieces every case script shares: yade-batch parameters (run with `yade-electro batch`) and gathering per-run results.
 
 Not a case itself (no JSON line); imported by the scripts in this folder.
 """

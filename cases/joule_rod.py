@@ -61,8 +61,8 @@ R_dem. Against the theory (power P_th = V^2 / R_th released in the volume pi R^2
 
 Run
 ---
-    yade -n -x cases/joule_rod.py                      # 5,000 elements, both models, 3 integrators
-    yade -n -x cases/joule_rod.py --n 1000 --laws voronoi --thetas backward-euler
+    yade-electro -n -x cases/joule_rod.py                      # 5,000 elements, both models, 3 integrators
+    yade-electro -n -x cases/joule_rod.py --n 1000 --laws voronoi --thetas backward-euler
 
 Writes ``out/joule_rod/joule_rod.csv`` (one row per model x integrator), the history CSV of
 every run, ``joule_rod.png`` (T(t) against theory) and ends with one JSON line. Importable

@@ -65,9 +65,9 @@ converge to at a given r_mean.
 
 Run
 ---
-    yade -n -x cases/notched_joule.py --n 5000 --law voronoi
-    yade -n -x cases/notched_joule.py --sweep                       # 5k..40k x both laws
-    yade-batch cases/notched_joule.table cases/notched_joule.py
+    yade-electro -n -x cases/notched_joule.py --n 5000 --law voronoi
+    yade-electro -n -x cases/notched_joule.py --sweep                       # 5k..40k x both laws
+    yade-electro batch cases/notched_joule.table cases/notched_joule.py
 
 Writes CSV/PNG to ``--out`` (default out/notched_joule/) and ends by printing one line of
 JSON. Importable (``run_notched``, ``fem_reference``) by the tests.

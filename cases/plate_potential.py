@@ -57,9 +57,9 @@ without any bond (``n_floating``, none in our plates) are left out.
 
 Run
 ---
-    yade -n -x cases/plate_potential.py --n 5000 --law voronoi      # one packing, one law
-    yade -n -x cases/plate_potential.py --sweep                      # 5k, 10k, 20k x both laws
-    yade-batch cases/plate_potential.table cases/plate_potential.py  # the same through yade-batch
+    yade-electro -n -x cases/plate_potential.py --n 5000 --law voronoi      # one packing, one law
+    yade-electro -n -x cases/plate_potential.py --sweep                      # 5k, 10k, 20k x both laws
+    yade-electro batch cases/plate_potential.table cases/plate_potential.py  # the same through yade-batch
 
 Writes CSV/PNG to ``--out`` (default out/plate_potential/) and ends by printing one line of
 JSON. Importable (``run_plate``, ``fem_reference``, ``control_point_value``) by the tests.
@@ -384,7 +384,7 @@ def collect(out_dir):
 
 
 def _params(argv):
-    """Parameters from the command line, or from a yade-batch table line."""
+    """Parameters from the command line, or from a yade-electro batch table line."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=1)

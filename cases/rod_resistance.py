@@ -16,9 +16,9 @@ r_mean) from the face, which is why the theoretical length is L - 2 r_mean.
 
 Run
 ---
-    yade -n -x cases/rod_resistance.py --n 5000 --seed 1         # one packing
-    yade -n -x cases/rod_resistance.py --sweep                     # Table III: 5 sizes x 3 seeds
-    yade-batch cases/rod_resistance.table cases/rod_resistance.py  # the same through yade-batch
+    yade-electro -n -x cases/rod_resistance.py --n 5000 --seed 1         # one packing
+    yade-electro -n -x cases/rod_resistance.py --sweep                     # Table III: 5 sizes x 3 seeds
+    yade-electro batch cases/rod_resistance.table cases/rod_resistance.py  # the same through yade-batch
 
 The script ends by printing one line of JSON with its figures. It is also importable
 (``run_rod``) by the tests.
@@ -196,7 +196,7 @@ def plot_sweep(rows, path):
 
 
 def _params(argv):
-    """Parameters from the command line, or from a yade-batch table line."""
+    """Parameters from the command line, or from a yade-electro batch table line."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=5000)
     ap.add_argument("--seed", type=int, default=1)

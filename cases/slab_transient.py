@@ -50,7 +50,7 @@ What is reported
   shown at 100 x and 1000 x (Crank-Nicolson stays bounded but overshoots; backward Euler
   keeps the maximum principle).
 
-Run (no YADE needed; also ``yade -n -x cases/slab_transient.py``)::
+Run (no YADE needed; also ``yade-electro -n -x cases/slab_transient.py``)::
 
     python3 cases/slab_transient.py [--layers 20] [--out out/slab_transient]
 

@@ -1,4 +1,4 @@
-"""Shared fixtures: the real YADE (in process or as ``yade -n -x`` subprocess) and LIGGGHTS.
+"""Shared fixtures: the real YADE (in process or as ``yade-electro -n -x`` subprocess) and LIGGGHTS.
 
 YADE and LIGGGHTS are required: a missing one fails the tests that need it, unless
 ``YADE_ELECTRO_ALLOW_SKIP=1`` is set, which turns those failures into skips.
@@ -20,7 +20,7 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_TIMEOUT = 600.0  # s, for one yade script
 
 YadeRun = collections.namedtuple("YadeRun", "returncode stdout stderr result")
-YadeRun.__doc__ = """Outcome of one ``yade -n -x`` run; ``result`` is the last JSON line of
+YadeRun.__doc__ = """Outcome of one ``yade-electro -n -x`` run; ``result`` is the last JSON line of
 stdout, parsed (None if there is none)."""
 
 _AUTO_MARKS = {"yade_module": "yade", "yade_exe": "yade", "run_yade_script": "yade",

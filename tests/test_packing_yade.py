@@ -1,7 +1,7 @@
 """Tests of the packing recipe (yade_electro.yade.packing).
 
 The placement and the statistics are numpy/scipy only; the tests marked ``yade`` run the
-real YADE (Debian package) in a subprocess ``yade -n -x`` or through the import path.
+real YADE (Debian package) in a subprocess ``yade-electro -n -x`` or through the import path.
 """
 import json
 import os

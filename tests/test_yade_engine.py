@@ -1,4 +1,4 @@
-"""ElectricalEngine and SceneReader in the real YADE, each case a fresh ``yade -n -x`` process
+"""ElectricalEngine and SceneReader in the real YADE, each case a fresh ``yade-electro -n -x`` process
 (one Omega per process). The scripts print their figures as one JSON line at the end."""
 import csv
 import io
@@ -111,7 +111,7 @@ print(json.dumps(out))
 '''
 
 BREAK_BONDS = PACKING + r'''
-e = make_engine(iterPeriod=1000, move_tolerance=1e3)
+e = make_engine(iterPeriod=1000, move_tolerance=1e3, bond_check="flags")   # every bond every call
 e.step()
 out = dict(R0=e.equivalent_resistance, I0=e.electrode_currents["top"], rev0=e.graph.revision, reads0=e.reader.full_reads,
            edges0=e.graph.n_edges)

@@ -1,4 +1,4 @@
-"""ElectroThermalEngine in the real YADE (each case a fresh ``yade -n -x`` process)."""
+"""ElectroThermalEngine in the real YADE (each case a fresh ``yade-electro -n -x`` process)."""
 import csv
 import io
 

@@ -215,7 +215,13 @@ class VoronoiLaw(ConductanceLaw):
 
     def factor(self, graph, edges=None):
         edges = self._edges(graph, edges)
-        return self.faces(graph).area_of(edges) / edge_lengths(graph, edges)
+        faces = self.faces(graph)
+        # the areas of one edge list are looked up once (moves change the lengths only)
+        if getattr(self, "_area_key", None) != (id(faces), id(edges)):
+            self._area_of_edges = faces.area_of(edges)
+            self._area_key = (id(faces), id(edges))
+            self._area_edges = edges                # keeps id(edges) from being reused
+        return self._area_of_edges / edge_lengths(graph, edges)
 
     def cell_volumes(self, graph) -> np.ndarray:
         """Bounded Voronoi cell volumes [m^3] from the kept tessellation."""

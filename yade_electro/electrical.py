@@ -301,16 +301,21 @@ class ElectricalModel:
         sol = self.solution
         if sol is None:
             raise RuntimeError("no solution yet")
-        row = {"R_eq": self.equivalent_resistance if self.measure else float("nan")}
-        for name in sol.electrode_current:
-            row[f"V_{name}"] = sol.electrode_potential[name]
-            row[f"I_{name}"] = sol.electrode_current[name]
-        row["joule_power"] = float(np.sum(self.joule_power()))
-        row["n_nodes"] = int(self.bond_graph.n_nodes)
-        row["n_edges"] = int(np.count_nonzero(self.conductance > 0))
-        row["n_floating"] = int(sol.floating.sum())
-        row["residual"] = sol.residual
-        row["current_imbalance"] = sol.current_imbalance
+        cached = getattr(self, "_summary_of", None)
+        if cached is not None and cached[0] is sol:          # the figures of a kept solution
+            row = dict(cached[1])
+        else:
+            row = {"R_eq": self.equivalent_resistance if self.measure else float("nan")}
+            for name in sol.electrode_current:
+                row[f"V_{name}"] = sol.electrode_potential[name]
+                row[f"I_{name}"] = sol.electrode_current[name]
+            row["joule_power"] = float(np.sum(self.joule_power()))
+            row["n_nodes"] = int(self.bond_graph.n_nodes)
+            row["n_edges"] = int(np.count_nonzero(self.conductance > 0))
+            row["n_floating"] = int(sol.floating.sum())
+            row["residual"] = sol.residual
+            row["current_imbalance"] = sol.current_imbalance
+            self._summary_of = (sol, dict(row))
         row["iterations"] = self.last_iterations
         row["solve_time"] = self.last_solve_time
         return row

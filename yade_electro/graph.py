@@ -177,6 +177,24 @@ class ContactGraph:
             return out
         return self._cached("barycentre", make)
 
+    def with_positions(self, pos, revision=None) -> "ContactGraph":
+        """A new graph of the same elements and bonds at other positions [m] (the elements
+        moved). The bonds and ids, validated already, are shared, not checked again."""
+        pos = np.asarray(pos, dtype=float)
+        if pos.shape != self.pos.shape:
+            raise GraphError(f"pos must have shape {self.pos.shape}, got {pos.shape}")
+        if not np.all(np.isfinite(pos)):
+            bad = np.flatnonzero(~np.all(np.isfinite(pos), axis=1))
+            raise GraphError(f"non-finite positions at nodes {bad[:10].tolist()}")
+        g = object.__new__(ContactGraph)
+        for name, value in (("pos", _readonly(pos)), ("radius", self.radius), ("edges", self.edges),
+                            ("ids", self.ids), ("revision", self.revision + 1 if revision is None else revision),
+                            ("_cache", {k: v for k, v in self._cache.items() if k in ("degree", "volume",
+                                                                                     "incidence", "components",
+                                                                                     "id_order")})):
+            object.__setattr__(g, name, value)
+        return g
+
     def with_edges(self, edges, revision=None) -> "ContactGraph":
         """A new graph with the same elements and other bonds (e.g. after bonds broke)."""
         return ContactGraph(self.pos, self.radius, edges, self.ids,

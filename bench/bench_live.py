@@ -1,0 +1,165 @@
+"""What the engines cost in a live YADE run: bonded rods under slow tension (the positions change
+every step), engine and no-engine blocks interleaved in one process.
+
+For each size (the rod case's bonded packings, seed 1) and configuration (ElectricalEngine
+every step and every 100 steps, ElectroThermalEngine every 100 steps; 'continuum' and, at the
+first size, 'voronoi'), the same simulation runs in alternating blocks: ``--blocks`` blocks of
+``steps`` without the engine and as many with it (the engine's PyRunner added, or made dead).
+The bottom layer is held, the top layer pulled at a strain rate that gives 1e-4 over the whole
+bench (no bond breaks; the engines see new positions at every geometry read).
+
+One JSON line per configuration::
+
+    {"bench": "live", "n", "engine", "law", "period", "ratio": wall_with / wall_without (sums
+     over the blocks), "ratio_median_of_pairs" (the median of the block pairs' ratios, less
+     sensitive to the machine's noise), "ratio_from_calls": 1 + (time in the engine's calls) /
+     wall_without, "rebuild_ms": the call that builds the structure (the first),
+     "unchanged_ms": median call that read nothing (no position read, nothing changed),
+     "positions_read_ms": median call that read the positions and found no move beyond the
+     tolerance, "median_call_ms", "max_call_ms" (a call that moved the values: new geometry,
+     warm re-solve, write-back), "max_over_unchanged", "max_over_positions_read", "calls",
+     "calls_by_kind", "structure_builds", "mech_step_ms", "load_average"}
+
+    yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+_SCRIPT = __file__ if __file__.endswith("bench_live.py") else next(
+    (a for a in sys.argv if a.endswith("bench_live.py")), __file__)
+HERE = os.path.dirname(os.path.abspath(_SCRIPT))
+sys.path.insert(0, os.path.dirname(HERE))
+sys.path.insert(0, HERE)
+
+import numpy as np  # noqa: E402
+
+from _benchlib import bonded_rod  # noqa: E402
+
+STRAIN = 1e-4
+
+
+def setup_pull(O, ids, top, bottom, total_steps, length):
+    rate = STRAIN / (total_steps * O.dt)
+    for i in ids[bottom]:
+        O.bodies[int(i)].state.blockedDOFs = "xyzXYZ"
+    for i in ids[top]:
+        b = O.bodies[int(i)]
+        b.state.blockedDOFs = "xyzXYZ"
+        b.state.vel = (0.0, 0.0, rate * length)
+
+
+def make_engine(kind, law, period, ids, top, bottom):
+    import joule_rod as jr
+    import rod_resistance as rod
+    from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
+    from yade_electro.geometry import Cylinder
+    el = {"top": dict(select=ids[top], potential=1.0), "bottom": dict(select=ids[bottom], potential=0.0)}
+    lp = {"container": Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)} if law == "voronoi" else None
+    if kind == "ElectricalEngine":
+        return ElectricalEngine(resistivity=rod.RHO_304L, electrodes=el, law=law, law_params=lp, iterPeriod=period,
+                                label=f"live_{law}_{period}")
+    return ElectroThermalEngine(resistivity=rod.RHO_304L, electrodes=el, density=jr.DENSITY,
+                                specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY, temperature=jr.T0,
+                                law=law, law_params=lp, iterPeriod=period, thermal_dt=1e-5,
+                                label=f"live_thermal_{law}_{period}")
+
+
+def timed(engine, times, kinds):
+    """Wrap the engine's step to record every call's wall time and what changed."""
+    step = engine.step
+
+    def wrapper():
+        reads, builds = engine.reader.full_reads, engine.model.updates["structure"] if engine.model else 0
+        geo = engine.reader.geometry_reads
+        t = time.perf_counter()
+        out = step()
+        times.append(time.perf_counter() - t)
+        changed = engine.reader.last_change
+        built = (engine.model.updates["structure"] if engine.model else 0) != builds
+        read = engine.reader.geometry_reads != geo
+        kinds.append("structure" if built else ("full read" if engine.reader.full_reads != reads else
+                                                 ("geometry" if changed == "geometry" else
+                                                  ("positions read" if read else "unchanged"))))
+        return out
+    engine.step = wrapper
+
+
+def bench(n, kind, law, period, steps, blocks):
+    from yade_electro.yade import registry
+    import rod_resistance as rod
+    O, ids, bottom, top = bonded_rod(n)
+    setup_pull(O, ids, top, bottom, 2 * blocks * steps + 10, rod.LENGTH)
+    O.run(5, True)
+    t = time.perf_counter()
+    engine = make_engine(kind, law, period, ids, top, bottom)
+    t_build = time.perf_counter() - t
+    times, kinds = [], []
+    timed(engine, times, kinds)
+    O.engines = O.engines + [engine.runner]
+    engine.runner.dead = True
+    wall = {"with": 0.0, "without": 0.0}
+    pair_ratios = []
+    for b in range(blocks):
+        w = {}
+        for mode in (("without", "with") if b % 2 == 0 else ("with", "without")):
+            engine.runner.dead = mode == "without"
+            t = time.perf_counter()
+            O.run(steps, True)
+            w[mode] = time.perf_counter() - t
+            wall[mode] += w[mode]
+        pair_ratios.append(w["with"] / w["without"])
+    t_all = np.array(times)
+    unchanged = t_all[np.array(kinds) == "unchanged"]
+    read_only = t_all[np.array(kinds) == "positions read"]
+    first = t_all[0] if len(t_all) else float("nan")
+    um = float(np.median(unchanged)) if unchanged.size else float("nan")
+    rest = t_all[1:]
+    row = {"bench": "live", "n": int(len(ids)), "engine": kind, "law": law, "period": int(period),
+           "ratio": round(wall["with"] / wall["without"], 4),
+           "ratio_median_of_pairs": round(float(np.median(pair_ratios)), 4),
+           "ratio_from_calls": round(1.0 + float(np.sum(t_all)) / wall["without"], 4),
+           "build_ms": round(1e3 * t_build, 2), "rebuild_ms": round(1e3 * first, 2),
+           "unchanged_ms": round(1e3 * um, 3),
+           "median_call_ms": round(1e3 * float(np.median(rest)), 3) if rest.size else None,
+           "max_call_ms": round(1e3 * float(rest.max()), 3) if rest.size else None,
+           "max_over_unchanged": round(float(rest.max()) / um, 2) if rest.size and um > 0 else None,
+           "positions_read_ms": round(1e3 * float(np.median(read_only)), 3) if read_only.size else None,
+           "max_over_positions_read": round(float(rest.max()) / float(np.median(read_only)), 2)
+           if rest.size and read_only.size else None,
+           "calls": int(len(times)), "calls_by_kind": {k: kinds.count(k) for k in set(kinds)},
+           "structure_builds": int(engine.model.updates["structure"]) if engine.model else None,
+           "steps_per_block": int(steps), "blocks": int(blocks),
+           "mech_step_ms": round(1e3 * wall["without"] / (blocks * steps), 3),
+           "load_average": round(os.getloadavg()[0], 2)}
+    engine.remove()
+    registry.ENGINES.pop(engine.label, None)
+    print(json.dumps(row), flush=True)
+    return row
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sizes", default="5000,20000")
+    ap.add_argument("--blocks", type=int, default=4)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    rows = []
+    for k, n in enumerate(int(x) for x in args.sizes.split(",")):
+        steps_1 = 200 if n <= 5000 else 60
+        configs = [("ElectricalEngine", "continuum", 1, steps_1),
+                   ("ElectricalEngine", "continuum", 100, 5 * steps_1 if n <= 5000 else 400),
+                   ("ElectroThermalEngine", "continuum", 100, 5 * steps_1 if n <= 5000 else 400)]
+        if k == 0:
+            configs += [("ElectricalEngine", "voronoi", 1, steps_1), ("ElectricalEngine", "voronoi", 100, 5 * steps_1),
+                        ("ElectroThermalEngine", "voronoi", 100, 5 * steps_1)]
+        for kind, law, period, steps in configs:
+            rows.append(bench(n, kind, law, period, steps, args.blocks))
+    return rows
+
+
+if __name__ == "__main__":
+    main()
