@@ -68,7 +68,7 @@ def bench_size(n, repeat=5, seed=1):
                                    theta=theta)
 
     for law in ("continuum", "voronoi"):
-        suffix = "" if law == "continuum" else "_voronoi"
+        suffix = "" if law == "continuum" else "_voronoi"   # put before "_ms": to_ms converts "*_ms"
         for tag, theta in (("be", "backward-euler"), ("explicit", "explicit")):
             if law == "voronoi" and tag == "explicit":
                 continue
@@ -77,7 +77,7 @@ def bench_size(n, repeat=5, seed=1):
                 t = time.perf_counter()
                 m = model(theta, beta, law)
                 m.step(graph, DT)
-                out[f"{tag}_{var}_first_ms{suffix}"] = time.perf_counter() - t
+                out[f"{tag}_{var}_first{suffix}_ms"] = time.perf_counter() - t
                 m.step(graph, DT)
                 models[var] = m
             # interleaved: one step of each in turn, best of repeat
@@ -90,7 +90,7 @@ def bench_size(n, repeat=5, seed=1):
                     times[var].append(time.perf_counter() - t)
                     out[f"{tag}_{var}_substeps{suffix}"] = int(row["n_substeps"])
             for var, m in models.items():
-                out[f"{tag}_{var}_ms{suffix}"] = min(times[var])
+                out[f"{tag}_{var}{suffix}_ms"] = min(times[var])
                 out[f"{tag}_{var}_potential_solves_per_step{suffix}"] = (m.n_potential_solves - solves0[var]) / repeat
             if tag == "be":
                 out[f"rho_T_step_ratio{suffix}"] = round(min(times["rho_T"]) / min(times["unchanged"]), 3)

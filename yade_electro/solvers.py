@@ -19,7 +19,7 @@ Solvers
     Comput. 21, 2000). The clusters come from the node coordinates (``set_geometry``; without
     them, from runs of a reverse Cuthill-McKee ordering of the matrix graph); the
     coarse matrix ``E = W^T A W`` is re-assembled by one scatter and refactorised on
-    ``update`` (dense inverse up to 400 clusters, sparse LU above). The smooth error modes
+    ``update`` (dense Cholesky up to 400 clusters, sparse LU above). The smooth error modes
     that make Jacobi-CG slow on elongated or fine packings are removed exactly, so the
     iteration count no longer grows with the number of elements.
 ``'cg-amg'``
@@ -256,7 +256,7 @@ class DeflatedCGSolver(CGSolver):
     """
 
     name = "cg-deflated"
-    #: up to this many clusters the coarse matrix is inverted (dense), above it factorised (sparse LU)
+    #: up to this many clusters the coarse matrix is factorised dense (Cholesky), above it sparse (LU)
     DENSE_LIMIT = 400
 
     def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, cluster_size: float = 3.0):
@@ -320,16 +320,19 @@ class DeflatedCGSolver(CGSolver):
         self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
         ev = np.bincount(self._e_slot, A.data, self._e_key.size)
         if k <= self.DENSE_LIMIT:
-            # small coarse space: its inverse, applied by one mat-vec per use
+            # small coarse space: a dense Cholesky factor (LAPACK, no checks in the way)
             E = np.zeros(k * k)
             E[self._e_key] = ev
             E = E.reshape(k, k)
-            try:
-                cf = sla.cho_factor(E, check_finite=False)
-            except np.linalg.LinAlgError as exc:
-                raise SolverError(f"the coarse matrix of 'cg-deflated' is not positive definite ({exc})") from None
-            Einv = sla.cho_solve(cf, np.eye(k), check_finite=False)
-            self._coarse_solve = Einv.__matmul__
+            from scipy.linalg.lapack import dpotrf, dpotrs
+            L, info = dpotrf(E, lower=1, clean=0, overwrite_a=1)
+            if info != 0:
+                raise SolverError(f"the coarse matrix of 'cg-deflated' is not positive definite (LAPACK potrf "
+                                  f"info {info})")
+
+            def coarse_solve(v, L=L):
+                return dpotrs(L, v, lower=1)[0]
+            self._coarse_solve = coarse_solve
         else:
             E = sp.csc_matrix((ev, (self._e_key // k, self._e_key % k)), shape=(k, k))
             lu = spla.splu(E, permc_spec="COLAMD")
