@@ -43,7 +43,7 @@ from .history import History
 from .materials import Material, edge_conductivity, real_number
 from .selection import Membership
 from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, diffusion_time_step, heat_capacity,
-                      joule_sources, theta_of)
+                      theta_of)
 
 __all__ = ["ElectroThermalModel"]
 
@@ -252,7 +252,7 @@ class ElectroThermalModel:
             self.solution = sol
             self._sol_id = sol
             self.n_potential_solves += 1
-            self.sources = joule_sources(el.network_edges, sol.branch_current, el.conductance, n, self.eta)
+            self.sources = el.element_joule_power(self.eta)
         return self.sources
 
     # -- stepping ----------------------------------------------------------------------------

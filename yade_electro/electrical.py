@@ -41,18 +41,35 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class ElectrodeSpec:
-    """An electrode to be resolved on a graph: a selector plus a fixed potential [V] or an
-    imposed current [A] (exactly one), checked at construction."""
+    """An electrode to be resolved on a graph: where it is, and a fixed potential [V] or an
+    imposed current [A] (exactly one), checked at construction.
+
+    ``select``: the element layer the electrode is (paper 000's convention: a perfect conductor
+    through the selected elements' centres). ``surface``: a surface of the container (e.g.
+    ``container.face('top')``, see :mod:`yade_electro.boundary`): the electrode is that surface,
+    each element with boundary faces on it connected through its half cell. Give one of them.
+    """
 
     name: str
-    select: Selector
+    select: Selector = None
     potential: Optional[float] = None
     current: Optional[float] = None
+    surface: object = None
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise BoundaryConditionError(f"electrode names must be non-empty strings, got {self.name!r}")
-        check_selector(self.select, f"electrode {self.name!r}: select")
+        if (self.select is None) == (self.surface is None):
+            raise BoundaryConditionError(f"electrode {self.name!r}: give select= (an element layer: a predicate, ids "
+                                         "or a mask) or surface= (a surface of the container), one of them")
+        if self.surface is not None:
+            from .geometry import as_surface
+            try:
+                as_surface(self.surface)
+            except ValueError as exc:
+                raise BoundaryConditionError(f"electrode {self.name!r}: {exc}") from None
+        else:
+            check_selector(self.select, f"electrode {self.name!r}: select")
         if (self.potential is None) == (self.current is None):
             raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
                                          "(fixed potential, V) or current= (imposed current, A)")
@@ -68,6 +85,8 @@ class ElectrodeSpec:
         return float(self.potential if self.fixed else self.current)
 
     def resolve(self, graph: ContactGraph) -> Electrode:
+        if self.surface is not None:
+            raise BoundaryConditionError(f"electrode {self.name!r} is a surface: resolve it through ElectricalModel")
         return Electrode(self.name, select_nodes(graph, self.select, self.name, "electrode"), self.potential,
                          self.current)
 
@@ -80,12 +99,10 @@ def electrode_specs(electrodes) -> List[ElectrodeSpec]:
             if isinstance(spec, ElectrodeSpec):
                 out.append(spec)
             elif isinstance(spec, Mapping):
-                unknown = set(spec) - {"select", "potential", "current"}
+                unknown = set(spec) - {"select", "surface", "potential", "current"}
                 if unknown:
                     raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give "
-                                                 "select=, and potential= (V) or current= (A)")
-                if "select" not in spec:
-                    raise BoundaryConditionError(f"electrode {name!r}: give select= (a predicate, ids or a mask)")
+                                                 "select= or surface=, and potential= (V) or current= (A)")
                 out.append(ElectrodeSpec(name, **spec))
             else:
                 raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=..., potential=...|current=...)")
@@ -121,10 +138,12 @@ class ElectricalModel:
     reselect : bool
         Re-evaluate the electrode selectors on every new structure instead of keeping the
         elements chosen the first time (by id).
+    container : Shape, optional
+        The solid's container, for surface electrodes (default: the 'voronoi' law's).
     """
 
     def __init__(self, resistivity, electrodes, law="continuum", law_params: Optional[dict] = None,
-                 solver="auto", measure: Optional[Sequence[str]] = None, reselect: bool = False):
+                 solver="auto", measure: Optional[Sequence[str]] = None, reselect: bool = False, container=None):
         self.material = resistivity if isinstance(resistivity, Material) else Material(resistivity=resistivity)
         self.material.require_electrical()
         self.specs = electrode_specs(electrodes)
@@ -143,7 +162,14 @@ class ElectricalModel:
             if len(measure) != 2 or any(m not in names for m in measure) or measure[0] == measure[1]:
                 raise BoundaryConditionError(f"measure={measure} must name two different electrodes of {names}")
         self.measure = tuple(measure) if measure else None
-        self.memberships: Dict[str, Membership] = {s.name: Membership(s.name, s.select, reselect) for s in self.specs}
+        self.memberships: Dict[str, Membership] = {s.name: Membership(s.name, s.select, reselect)
+                                                   for s in self.specs if s.surface is None}
+        self.container = container if container is not None else getattr(self.law, "container", None)
+        self._boundary = None
+        if any(s.surface is not None for s in self.specs):
+            from .boundary import BoundaryOfGraph
+            self._boundary = BoundaryOfGraph(self.container, self.law)
+        self.contacts: Dict = {}          # surface electrode name -> SurfaceContact (by id once made)
         self.values: Dict[str, float] = {s.name: s.value for s in self.specs}
         self.resistivity = self.material.resistivity
         self.network = FactorNetwork(self.law)
@@ -154,6 +180,9 @@ class ElectricalModel:
         self.updates = {"structure": 0, "topology": 0, "geometry": 0, "resistivity": 0}
         self._rho_stale = False
         self._graph_view = None
+        self._surface_edges = np.zeros((0, 2), dtype=np.int64)
+        self._surface_factor = np.zeros(0)
+        self.n_elements = None
 
     # -- values (owned here) -----------------------------------------------------------------
     @property
@@ -211,23 +240,86 @@ class ElectricalModel:
                                                   g.revision))
         return self._graph_view[1]
 
+    def _full_conductance(self, n):
+        """Conductances [S] of the problem's edges: the law's network (g / rho_edge), then the
+        surface electrodes' half cells (g / rho of the element)."""
+        c = self.network.factor / self._rho_edge(self.network.edges, n)
+        if self._surface_edges.size:
+            rho = np.asarray(self.resistivity, float)
+            rho_i = rho if rho.ndim == 0 else rho[self._surface_edges[:, 0]]
+            c = np.concatenate([c, self._surface_factor / rho_i])
+        return c
+
+    @property
+    def edges(self) -> np.ndarray:
+        """Every edge of the problem: ``network_edges``, then the surface electrodes' half
+        cells (element, electrode node); the solution's ``branch_current`` follows them."""
+        return self.problem.edges
+
+    def element_joule_power(self, eta: float = 1.0) -> np.ndarray:
+        """Joule heat [W] per element: each network edge's eta w^2 / c shared half and half by
+        its ends, a surface half cell's given to its element."""
+        from .network import edge_power
+        n, m = self.n_elements, self.network.edges.shape[0]
+        p = eta * edge_power(self.solution.branch_current, self.conductance)
+        e = self.network.edges
+        out = 0.5 * (np.bincount(e[:, 0], p[:m], n) + np.bincount(e[:, 1], p[:m], n))
+        if self._surface_edges.size:
+            out += np.bincount(self._surface_edges[:, 0], p[m:], n)
+        return out
+
     def _rho_edge(self, edges, n):
         rho = self.resistivity
         if np.ndim(rho) == 1 and np.shape(rho)[0] != n:
             raise BoundaryConditionError(f"resistivity has {np.shape(rho)[0]} values but the packing has {n} elements")
         return edge_resistivity(rho, edges)
 
+    def _surface_contact(self, spec, graph):
+        """The elements a surface electrode touches (made once, kept by element id)."""
+        from .boundary import SurfaceContact, surface_contact
+        kept = self.contacts.get(spec.name)
+        if kept is None:
+            cells, pos = self._boundary.cells(graph)
+            contact = surface_contact(cells, pos, spec.surface, spec.name)
+            self.contacts[spec.name] = (graph.ids[contact.nodes].copy(), contact)
+            return contact
+        ids, contact = kept
+        present = np.isin(ids, graph.ids)
+        if not np.any(present):
+            raise BoundaryConditionError(f"electrode {spec.name!r}: none of its elements is left in the packing")
+        nodes = graph.index_of(ids[present])
+        order = np.argsort(nodes)
+        return SurfaceContact(spec.name, nodes[order], contact.area[present][order], contact.factor[present][order],
+                              contact.depth[present][order])
+
     def _build(self, graph: ContactGraph):
-        electrodes = []
+        n = graph.n_nodes
+        electrodes, surf_edges, surf_g, surf_nodes = [], [], [], []
         for s in self.specs:
-            nodes = self.memberships[s.name].nodes(graph)
-            electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
-        edges = self.network.edges
-        c = self.network.factor / self._rho_edge(edges, graph.n_nodes)
+            if s.surface is not None:
+                contact = self._surface_contact(s, graph)
+                k = n + len(surf_nodes)
+                surf_nodes.append(k)
+                surf_edges.append(np.column_stack([contact.nodes, np.full(contact.nodes.size, k)]))
+                surf_g.append(contact.factor)
+                electrodes.append(Electrode(s.name, [k], potential=s.potential, current=s.current))
+            else:
+                nodes = self.memberships[s.name].nodes(graph)
+                electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
+        self._surface_edges = np.concatenate(surf_edges) if surf_edges else np.zeros((0, 2), dtype=np.int64)
+        self._surface_factor = np.concatenate(surf_g) if surf_g else np.zeros(0)
+        self.n_elements = n
+        edges = np.concatenate([self.network.edges, self._surface_edges])
+        c = self._full_conductance(n)
+        coords = graph.pos
+        if surf_nodes:
+            # a surface electrode's node sits at the mean centre of its elements (only the
+            # deflated solver's clusters look at it, and it is not an unknown)
+            coords = np.concatenate([graph.pos] + [graph.pos[e[:, 0]].mean(axis=0)[None, :] for e in surf_edges])
         solver = self.solver
         if self.problem is not None and not isinstance(self.solver, str):
             solver = self.problem.solver
-        self.problem = ConductionProblem(graph.n_nodes, edges, c, electrodes, solver=solver, coords=graph.pos)
+        self.problem = ConductionProblem(n + len(surf_nodes), edges, c, electrodes, solver=solver, coords=coords)
         self.conductance = c
         self.rebuilds += 1
         self.updates["structure"] += 1
@@ -249,7 +341,7 @@ class ElectricalModel:
                 return None
             kind = "resistivity"
         self._rho_stale = False
-        c = self.network.factor / self._rho_edge(self.network.edges, graph.n_nodes)
+        c = self._full_conductance(graph.n_nodes)
         if np.array_equal(c, self.conductance):
             return None
         self.conductance = c
@@ -311,8 +403,8 @@ class ElectricalModel:
                 row[f"I_{name}"] = sol.electrode_current[name]
             row["joule_power"] = float(np.sum(self.joule_power()))
             row["n_nodes"] = int(self.bond_graph.n_nodes)
-            row["n_edges"] = int(np.count_nonzero(self.conductance > 0))
-            row["n_floating"] = int(sol.floating.sum())
+            row["n_edges"] = int(np.count_nonzero(self.conductance[:self.network.edges.shape[0]] > 0))
+            row["n_floating"] = int(sol.floating[:self.n_elements].sum())
             row["residual"] = sol.residual
             row["current_imbalance"] = sol.current_imbalance
             self._summary_of = (sol, dict(row))

@@ -107,6 +107,11 @@ class Shape:
         """The shapes this one is combined from (empty for a primitive)."""
         return ()
 
+    def surface(self, tol=None) -> "SurfaceSelector":
+        """This shape's whole boundary as a surface selector (points within ``tol`` of it;
+        default 1e-6 of the bounding box)."""
+        return OnSurface(self, tol)
+
     def __sub__(self, other):
         return Difference(self, as_shape(other))
 
@@ -182,6 +187,29 @@ class Cylinder(Shape):
     def key(self):
         return ("Cylinder", self.c1.tolist(), self.c2.tolist(), self.radius)
 
+    def face(self, name: str, tol=None) -> "SurfaceSelector":
+        """One face as a surface selector: ``'top'`` (the end at ``c2``), ``'bottom'`` (at
+        ``c1``) or ``'side'`` (the lateral surface)."""
+        if name == "top":
+            return Plane(self.c2, self.axis, tol if tol is not None else 1e-6 * self.length)
+        if name == "bottom":
+            return Plane(self.c1, -self.axis, tol if tol is not None else 1e-6 * self.length)
+        if name == "side":
+            cyl = self
+            t = tol if tol is not None else 1e-6 * self.length
+
+            def side(points, normals):
+                p = np.asarray(points, float) - cyl.c1
+                ax = p @ cyl.axis
+                q = p - ax[:, None] * cyl.axis
+                rho = np.linalg.norm(q, axis=1)
+                radial = np.einsum("ij,ij->i", np.asarray(normals, float), q / np.maximum(rho, 1e-300)[:, None])
+                # tangent-plane pieces of a curved wall sit slightly outside it: h^2 / (8 R)
+                return (np.abs(rho - cyl.radius) <= max(t, 0.05 * cyl.radius)) & (ax > -t) & (ax < cyl.length + t) \
+                    & (radial > 0.5)
+            return SurfaceSelector(side, f"{self!r}.face('side')")
+        raise ValueError(f"a Cylinder has the faces 'top', 'bottom' and 'side', not {name!r}")
+
     def __repr__(self):
         return f"Cylinder(c1={tuple(self.c1)}, c2={tuple(self.c2)}, radius={self.radius})"
 
@@ -241,6 +269,18 @@ class Box(Shape):
 
     def key(self):
         return ("Box", self.lo.tolist(), self.hi.tolist())
+
+    def face(self, name: str, tol=None) -> "SurfaceSelector":
+        """One face as a surface selector: ``'x-'``, ``'x+'``, ``'y-'``, ``'y+'``, ``'z-'``,
+        ``'z+'``."""
+        names = {f"{a}{sg}": (k, sg) for k, a in enumerate("xyz") for sg in "-+"}
+        if name not in names:
+            raise ValueError(f"a Box has the faces {', '.join(names)}, not {name!r}")
+        k, sg = names[name]
+        n = np.zeros(3)
+        n[k] = 1.0 if sg == "+" else -1.0
+        p = self.hi.copy() if sg == "+" else self.lo.copy()
+        return Plane(p, n, tol if tol is not None else 1e-6 * float(np.max(self.hi - self.lo)))
 
     def __repr__(self):
         return f"Box(lo={tuple(self.lo)}, hi={tuple(self.hi)})"
@@ -479,3 +519,74 @@ def container_volume(shape, n_samples=4_000_000, seed=20240607) -> tuple:
         hits += int(np.count_nonzero(shape.sdf(lo + (hi - lo) * rng.random((m, 3))) <= 0))
         done += m
     return float(np.prod(hi - lo) * hits / n_samples), f"monte-carlo(n={n_samples}, seed={seed})"
+
+
+# =========================================================================================
+# Surfaces: which boundary faces a surface boundary condition acts on
+# =========================================================================================
+class SurfaceSelector:
+    """Picks boundary faces (a point on each and its outward normal) that lie on a surface.
+
+    ``SurfaceSelector(fn)`` wraps ``fn(points (b, 3), normals (b, 3)) -> bool mask``. Made by
+    :class:`Plane`, ``Shape.face(name)``, ``Shape.surface()`` and :func:`as_surface`.
+    """
+
+    def __init__(self, fn, description="surface"):
+        self.fn, self.description = fn, description
+
+    def __call__(self, points, normals) -> np.ndarray:
+        return np.asarray(self.fn(np.asarray(points, float), np.asarray(normals, float)), dtype=bool)
+
+    def __repr__(self):
+        return self.description
+
+
+class Plane(SurfaceSelector):
+    """The faces on the plane through ``point`` with outward ``normal`` (within ``tol`` [m]),
+    facing the same way (normal . n > 0.5)."""
+
+    def __init__(self, point, normal, tol):
+        self.point = np.asarray(point, float).reshape(3)
+        n = np.asarray(normal, float).reshape(3)
+        if not np.linalg.norm(n) > 0:
+            raise ValueError("a Plane needs a non-zero normal")
+        self.normal = n / np.linalg.norm(n)
+        self.tol = float(tol)
+        if not self.tol > 0:
+            raise ValueError(f"a Plane needs tol > 0 [m], got {tol}")
+        super().__init__(self._select, f"Plane(point={tuple(self.point)}, normal={tuple(self.normal)})")
+
+    def _select(self, points, normals):
+        return (np.abs((points - self.point) @ self.normal) <= self.tol) & (normals @ self.normal > 0.5)
+
+
+class OnSurface(SurfaceSelector):
+    """The faces on a shape's boundary (|sdf| <= tol)."""
+
+    def __init__(self, shape, tol=None):
+        lo, hi = shape.bounds()
+        self.shape = shape
+        self.tol = float(tol) if tol is not None else 1e-6 * float(np.max(hi - lo))
+        super().__init__(lambda p, n: np.abs(shape.sdf(p)) <= self.tol, f"{shape!r}.surface()")
+
+
+def as_surface(surface) -> SurfaceSelector:
+    """A surface selector from a SurfaceSelector, a callable ``f(points, normals) -> mask``,
+    or a region (a Shape or YADE predicate: the faces whose centre lies inside it)."""
+    if isinstance(surface, SurfaceSelector):
+        return surface
+    if isinstance(surface, Shape) or (callable(surface) and hasattr(surface, "aabb")):
+        region = surface if isinstance(surface, Shape) else None
+        if region is not None:
+            return SurfaceSelector(lambda p, n: region.sdf(p) <= 0, f"faces inside {region!r}")
+        pred = surface
+        return SurfaceSelector(lambda p, n: np.array([bool(pred(tuple(x), 0.0)) for x in p], dtype=bool),
+                               f"faces inside {type(pred).__name__}")
+    if callable(surface):
+        return SurfaceSelector(surface, getattr(surface, "__name__", "surface"))
+    raise ValueError(f"a surface is a face of a shape (shape.face(...)), a Plane, a region (a Shape or YADE "
+                     f"predicate holding the faces) or a callable f(points, normals) -> mask; got {surface!r}")
+
+
+__all__ += ["SurfaceSelector", "Plane", "OnSurface", "as_surface"]
+

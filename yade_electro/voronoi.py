@@ -239,6 +239,30 @@ class BoundedCells:
         return np.bincount(self.boundary_owner, self.boundary_area, n)
 
 
+def _piece_planes(container, v, owner, d, tol):
+    """Tangent planes (feet, unit normals), their cells and distances, for the outside points
+    ``v``: one plane per smooth piece of the container each point is beyond by more than
+    ``tol`` (``wall_terms``; a shape without pieces gives its signed distance's gradient)."""
+    terms = container.wall_terms(v) if hasattr(container, "wall_terms") else [(d, lambda i: container.gradient(v[i]))]
+    feet, nrm, own, dist = [], [], [], []
+    for g, normal in terms:
+        g = np.asarray(g, float)
+        sel = np.flatnonzero(g > tol)
+        if sel.size == 0:
+            continue
+        n = np.asarray(normal(sel), float)
+        n = n / np.linalg.norm(n, axis=1)[:, None]
+        feet.append(v[sel] - g[sel, None] * n)
+        nrm.append(n)
+        own.append(owner[sel])
+        dist.append(g[sel])
+    if not feet:               # the pieces missed it (rounding): the signed distance's own plane
+        n = np.asarray(container.gradient(v), float)
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        return v - d[:, None] * n, n, owner, d
+    return np.concatenate(feet), np.concatenate(nrm), np.concatenate(own), np.concatenate(dist)
+
+
 def _protrusion_integral(verts, count, centre, container):
     """Integral of max(sdf, 0) over ordered planar polygons (b, P, 3) [m^3]: fan triangles from
     ``centre`` (b, 3), the edge-midpoint rule on each (exact for quadratics)."""
@@ -387,12 +411,12 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
             _, uniq = np.unique(np.column_stack([fo[o_idx], vkey]), axis=0, return_index=True)
             o_idx = o_idx[uniq]
             o_idx = o_idx[np.lexsort((-d[o_idx], fo[o_idx]))]
-            # their tangent planes, each distinct plane once per cell (on a planar wall
-            # every outside vertex gives the wall itself), the farthest first
-            g = np.asarray(container.gradient(fv[o_idx]), float)
-            g /= np.linalg.norm(g, axis=1)[:, None]
-            feet = fv[o_idx] - d[o_idx, None] * g
-            oc = fo[o_idx]
+            # their tangent planes, each distinct plane once per cell, the farthest first: one
+            # per smooth piece of the container the vertex is beyond (Shape.wall_terms), so that
+            # at an edge (a rod's rim) each face cuts with its own plane (an end face exactly)
+            feet, g, oc, dist = _piece_planes(container, fv[o_idx], fo[o_idx], d[o_idx], 1e-9 * size[fo[o_idx]])
+            order = np.lexsort((-dist, oc))
+            feet, g, oc = feet[order], g[order], oc[order]
             pkey = np.column_stack([oc, np.round(g * 1e6), np.round(np.einsum("ij,ij->i", g, feet)
                                                                    / (1e-7 * size[oc]))])
             _, uniq = np.unique(pkey, axis=0, return_index=True)

@@ -354,19 +354,19 @@ class ElectricalEngine(_Engine):
     @property
     def potential(self) -> np.ndarray:
         """Potential [V] of each element, in ``body_ids`` order."""
-        return self.solution.potential
+        return self.solution.potential[:self.model.n_elements]
 
     @property
     def potential_by_id(self) -> Dict[int, float]:
-        return dict(zip(self.body_ids.tolist(), self.solution.potential.tolist()))
+        return dict(zip(self.body_ids.tolist(), self.potential.tolist()))
 
     @property
     def branch_currents(self):
         """(id pairs (m, 2), current (m,) [A] flowing from the first body to the second), over
         the edges that conduct."""
-        c = self.model.conductance
-        keep = c > 0
-        return self.body_ids[self.model.network_edges[keep]], self.solution.branch_current[keep]
+        m = self.model.network_edges.shape[0]
+        keep = self.model.conductance[:m] > 0
+        return self.body_ids[self.model.network_edges[keep]], self.solution.branch_current[:m][keep]
 
     @property
     def electrode_currents(self) -> Dict[str, float]:
