@@ -235,3 +235,22 @@ def test_richardson_on_a_known_sequence():
     assert not osc.monotone and osc.order == 2.0 and osc.gci == pytest.approx(0.05)
     two = converged(lambda h: {"a": 1 + h, "b": 2 - h * h}, hs)
     assert abs(two["a"].order - 1) < 1e-8 and abs(two["b"].extrapolated - 2) < 1e-12
+
+
+@needs_gmsh
+def test_cracked_bar_is_a_slit_and_approaches_the_closed_form_from_below():
+    """The edge crack of the 2 x 2 x 8 mm bar: the slit conducts nothing (a crack through
+    90 % of the width raises R far more), and the P1 increments (a lower bound of R: the
+    FEM energy is above the true one at fixed potentials) rise towards Johnson's closed
+    form 0.1103 as the mesh is refined."""
+    exact = fem.edge_crack_increment(2e-3, 8e-3, 1e-3)
+    assert exact == pytest.approx(4 * 2 / (math.pi * 8) * math.log(math.sqrt(2)), rel=1e-12)
+    coarse = fem.cracked_bar(h=0.5e-3)["increment"]
+    finer = fem.cracked_bar(h=0.35e-3)["increment"]
+    assert 0.85 * exact < coarse < finer < exact
+    deep = fem.cracked_bar(fem.CrackedBarGeometry(crack_depth=1.8e-3), h=0.5e-3)["increment"]
+    assert deep > 5 * coarse
+    with pytest.raises(ValueError, match="depth < width"):
+        fem.edge_crack_increment(2e-3, 8e-3, 2e-3)
+    with pytest.raises(fem.MeshError, match="inside the bar"):
+        fem.CrackedBarGeometry(crack_depth=3e-3)

@@ -28,10 +28,14 @@ continuum
 voronoi
     Faces of the Voronoi tessellation of the element centres, bounded by the solid's
     ``container`` (a :class:`yade_electro.geometry.Shape`): g = A_ij / l_ij, exact for uniform
-    fields (see :mod:`yade_electro.voronoi`). A face conducts while its two elements are linked
-    by a path of at most ``hops`` (3) intact bonds. The tessellation is made on the first
-    configuration of an element set (or the ``reference`` one: ids, positions, radii) and kept
-    (small-strain view: the faces keep their areas, l_ij follows the elements).
+    fields (see :mod:`yade_electro.voronoi`). Cracks (``crack='facets'``, the default): a face
+    of a pair bonded in the reference conducts while its bond is intact; a face of an unbonded
+    pair conducts while its elements are linked by at most ``hops`` (3) intact bonds and no
+    broken bond's *facet* (its own Voronoi face) lies across the segment between them. ``crack='paths'`` is the earlier rule
+    (every face conducts while its elements are linked by <= hops intact bonds), which leaks
+    near a crack front. The tessellation is made on the first configuration of an element set
+    (or the ``reference`` one: ids, positions, radii, bonds) and kept (small-strain view: the
+    faces keep their areas, l_ij follows the elements).
 contact
     Constriction of two overlapping spheres (papers 002, 003): g = 2 a, a the radius of the
     contact circle of the lens.
@@ -91,7 +95,19 @@ def make_law(law="continuum", **params) -> "ConductanceLaw":
             raise ValueError("give parameters to make_law only with a law name")
         return law
     check_law_name(law)
-    return _LAWS[law](**params)
+    cls = _LAWS[law]
+    import inspect
+    accepted = inspect.signature(cls.__init__).parameters
+    if not any(p.kind is p.VAR_KEYWORD for p in accepted.values()):
+        unknown = sorted(set(params) - set(accepted))
+        if "crack" in unknown or "hops" in unknown:
+            raise ValueError(f"law {law!r} has no Voronoi faces, so it takes no crack rule (crack=, hops=): its "
+                             "network is the intact bonds, and a broken bond simply stops conducting. Use "
+                             "law='voronoi' (container=...) for the crack rules")
+        if unknown:
+            known = sorted(k for k in accepted if k != "self")
+            raise ValueError(f"law {law!r} takes no parameter(s) {unknown}; its parameters: {known}")
+    return cls(**params)
 
 
 def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
@@ -179,14 +195,18 @@ class VoronoiLaw(ConductanceLaw):
     name = "voronoi"
     needs_container = True
 
-    def __init__(self, container=None, hops: int = 3, reference=None):
+    def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets"):
         if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
             raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
                              "and gradient(x) (e.g. yade_electro.geometry.as_shape(predicate)); "
                              f"got {container!r}")
         if isinstance(hops, bool) or int(hops) != hops or hops < 1:
             raise ValueError(f"hops must be an integer >= 1, got {hops!r}")
-        self.container, self.hops = container, int(hops)
+        if crack not in ("facets", "paths"):
+            raise ValueError(f"crack must be 'facets' (the broken bonds' facets cut the faces across them) or "
+                             f"'paths' (a face conducts while its elements are linked by <= hops bonds), got {crack!r}")
+        self.container, self.hops, self.crack = container, int(hops), crack
+        # reference: (ids, pos, radius[, bonds]) of the configuration the faces are made on
         self.reference = None if reference is None else tuple(np.asarray(a) for a in reference)
         self._faces = None
         self._key = None
@@ -201,17 +221,21 @@ class VoronoiLaw(ConductanceLaw):
             from .voronoi import VoronoiFaces
             ref = self.reference
             if ref is not None and ref[0].shape == graph.ids.shape and np.array_equal(ref[0], graph.ids):
-                base = ContactGraph(ref[1], ref[2], np.zeros((0, 2), dtype=np.int64), ref[0])
+                bonds = ref[3] if len(ref) > 3 else graph.edges
+                base = ContactGraph(ref[1], ref[2], bonds, ref[0])
             else:
                 base = graph
             self._faces = VoronoiFaces.of(base, self.container)
-            self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius))
+            self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius), np.array(base.edges))
             self._key = key
             self.tessellations += 1
         return self._faces
 
     def network(self, graph):
-        return self.faces(graph).supported_pairs(graph.edges, self.hops)
+        faces = self.faces(graph)
+        if self.crack == "paths":
+            return faces.supported_pairs(graph.edges, self.hops)
+        return faces.cracked(self.reference[1], graph.edges, self.reference[3], self.hops)
 
     def factor(self, graph, edges=None):
         edges = self._edges(graph, edges)

@@ -8,20 +8,21 @@ see docs/fem.md. Needs scikit-fem (PyPI, pure Python) and, for curved or notched
 geometries, gmsh's Python API (Debian package python3-gmsh). SI units.
 """
 from .closed_forms import (adiabatic_joule_temperature, bar_resistance, coax_resistance,
-                           joule_parabola, slab_temperature)
+                           edge_crack_increment, joule_parabola, slab_temperature)
 from .convergence import Convergence, converged, richardson
-from .meshes import (MeshError, NotchedBarGeometry, PlateGeometry, box_mesh, coax_mesh,
-                     mesh_size, notched_bar_mesh, plate_mesh, rod_mesh)
+from .meshes import (CrackedBarGeometry, MeshError, NotchedBarGeometry, PlateGeometry, box_mesh, coax_mesh,
+                     cracked_bar_mesh, mesh_size, notched_bar_mesh, plate_mesh, rod_mesh)
 from .potential import PotentialSolution, make_basis, solve_potential
 from .probing import ProbeError, line_points, probe_matrix, slab_average, subdomain_average
-from .references import (STEEL_304L, Material, notched_bar, notched_bar_reference,
+from .references import (STEEL_304L, Material, cracked_bar, cracked_bar_reference, notched_bar, notched_bar_reference,
                          plate_potential, plate_reference, rod_joule_heating, rod_reference,
                          rod_resistance, slab_conduction)
 from .thermal import ThermalResult, joule_heating, steady_temperature, transient_conduction
 
 __all__ = [
     "adiabatic_joule_temperature", "bar_resistance", "coax_resistance", "joule_parabola",
-    "slab_temperature", "Convergence", "converged", "richardson", "MeshError",
+    "slab_temperature", "edge_crack_increment", "CrackedBarGeometry", "cracked_bar_mesh", "cracked_bar",
+    "cracked_bar_reference", "Convergence", "converged", "richardson", "MeshError",
     "NotchedBarGeometry", "PlateGeometry", "box_mesh", "coax_mesh", "mesh_size",
     "notched_bar_mesh", "plate_mesh", "rod_mesh", "PotentialSolution", "make_basis",
     "solve_potential", "ProbeError", "line_points", "probe_matrix", "slab_average",

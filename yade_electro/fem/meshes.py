@@ -504,3 +504,94 @@ def notched_bar_mesh(geometry: NotchedBarGeometry = NotchedBarGeometry(), h: flo
     }).with_subdomains({
         "notch": lambda x: (x[0] > a - 1e-9 * g.length) & (x[0] < b + 1e-9 * g.length),
     })
+
+
+# --------------------------------------------------------------------------- cracked bar
+@dataclass(frozen=True)
+class CrackedBarGeometry:
+    """A square bar ``width`` x ``width`` x ``length`` [m] (z along its length) with a planar
+    edge crack of zero thickness at z = ``crack_z`` (default mid-length), from the face x = 0
+    to x = ``crack_depth`` (default half the width), through the whole thickness in y."""
+
+    width: float = 2e-3
+    length: float = 8e-3
+    crack_depth: float = 1e-3
+    crack_z: float = None
+
+    def __post_init__(self):
+        _positive(width=self.width, length=self.length, crack_depth=self.crack_depth)
+        if self.crack_z is None:
+            object.__setattr__(self, "crack_z", 0.5 * self.length)
+        if not (0 < self.crack_depth < self.width) or not (0 < self.crack_z < self.length):
+            raise MeshError("the crack must lie inside the bar: 0 < crack_depth < width, 0 < crack_z < length")
+
+
+@functools.lru_cache(maxsize=16)
+def cracked_bar_mesh(geometry: CrackedBarGeometry = CrackedBarGeometry(), h: float = 0.25e-3,
+                     front_refinement: float = 0.25) -> MeshTet:
+    """Mesh of :class:`CrackedBarGeometry`: size ``h``, ``front_refinement * h`` near the
+    crack front (the line x = crack_depth, z = crack_z), the crack a true slit: the bar is
+    meshed in four blocks that share the plane z = crack_z, and the nodes of that plane with
+    x < crack_depth are duplicated for the blocks above it, so nothing conducts across the
+    crack while the ligament (x > crack_depth) and the front itself stay joined.
+
+    Returns
+    -------
+    skfem.MeshTet
+        Boundaries ``end0`` (z = 0), ``end1`` (z = length).
+    """
+    g = geometry
+    _positive(h=h, front_refinement=front_refinement)
+    a, zc, W, L = g.crack_depth, g.crack_z, g.width, g.length
+    h_f = front_refinement * h
+
+    def sizes(gmsh):
+        f = gmsh.model.mesh.field
+        dist = f.add("Distance")
+        f.setNumbers(dist, "CurvesList", [front])
+        f.setNumber(dist, "NumPointsPerCurve", 200)
+        thr = f.add("Threshold")
+        f.setNumber(thr, "InField", dist)
+        f.setNumber(thr, "SizeMin", h_f)
+        f.setNumber(thr, "SizeMax", h)
+        f.setNumber(thr, "DistMin", 2 * h_f)
+        f.setNumber(thr, "DistMax", 2 * h)
+        f.setAsBackgroundMesh(thr)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+
+    with _GmshSession() as gmsh:
+        occ = gmsh.model.occ
+        blocks = [(3, occ.addBox(0, 0, 0, a, W, zc)), (3, occ.addBox(a, 0, 0, W - a, W, zc)),
+                  (3, occ.addBox(0, 0, zc, a, W, L - zc)), (3, occ.addBox(a, 0, zc, W - a, W, L - zc))]
+        occ.fragment(blocks, [])
+        occ.synchronize()
+        # the crack front: the curve on x = a, z = zc
+        front = None
+        tb = 1e-2 * h_f                               # OCC bounding boxes carry a tolerance
+        for dim, tag in gmsh.model.getEntities(1):
+            bb = gmsh.model.getBoundingBox(dim, tag)
+            if abs(bb[0] - a) < tb and abs(bb[3] - a) < tb and abs(bb[2] - zc) < tb and abs(bb[5] - zc) < tb:
+                front = tag
+        if front is None:
+            raise MeshError("could not find the crack front curve in the gmsh model")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+        sizes(gmsh)
+        gmsh.model.mesh.generate(3)
+        p, t = _tets_from_gmsh(gmsh)
+    # the slit: nodes of z = zc with x < a (not the front) get a twin for the tets above
+    tol = 1e-9 * L
+    on_crack = (np.abs(p[2] - zc) < tol) & (p[0] < a - 1e-9 * W)
+    cen_z = p[2][t].mean(axis=0)
+    twin = np.full(p.shape[1], -1, dtype=np.int64)
+    idx = np.flatnonzero(on_crack)
+    twin[idx] = p.shape[1] + np.arange(idx.size)
+    p = np.concatenate([p, p[:, idx]], axis=1)
+    above = cen_z > zc
+    t = t.copy()
+    sub = t[:, above]
+    sub = np.where(twin[sub] >= 0, twin[sub], sub)
+    t[:, above] = sub
+    mesh = _to_skfem(p, t)
+    return mesh.with_boundaries({"end0": lambda x: np.abs(x[2]) < tol, "end1": lambda x: np.abs(x[2] - L) < tol})

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .closed_forms import adiabatic_joule_temperature, bar_resistance, slab_temperature
+from .closed_forms import adiabatic_joule_temperature, bar_resistance, edge_crack_increment, slab_temperature
 from .convergence import converged
 from .meshes import (NotchedBarGeometry, PlateGeometry, box_mesh, notched_bar_mesh,
                      plate_mesh, rod_mesh)
@@ -253,3 +253,44 @@ def notched_bar_reference(geometry: NotchedBarGeometry = NotchedBarGeometry(),
         out = notched_bar(geometry, h, **kwargs)
         return {k: out[k] for k in keys}
     return converged(run, hs)
+
+
+# --------------------------------------------------------------------------- cracked bar
+def cracked_bar(geometry=None, h: float = 0.25e-3, material: Material = STEEL_304L, order: int = 1,
+                front_refinement: float = 0.25) -> dict:
+    """Resistance of the square bar between its end faces with and without its edge crack
+    (:class:`~yade_electro.fem.meshes.CrackedBarGeometry`).
+
+    Returns
+    -------
+    dict
+        ``R_crack``, ``R_intact`` (= rho L / W^2, exact: a bar), ``increment`` =
+        R_crack / R_intact - 1, ``ndofs``, ``h``.
+    """
+    from .meshes import CrackedBarGeometry, cracked_bar_mesh
+    g = CrackedBarGeometry() if geometry is None else geometry
+    sol = solve_potential(cracked_bar_mesh(g, h, front_refinement), material.resistivity, {"end1": 1.0, "end0": 0.0},
+                          order=order)
+    r = sol.equivalent_resistance("end1", "end0")
+    r0 = bar_resistance(material.resistivity, g.length, g.width ** 2)
+    return {"R_crack": r, "R_intact": r0, "increment": r / r0 - 1.0, "ndofs": sol.ndofs, "h": h}
+
+
+def cracked_bar_reference(geometry=None, hs=(0.35e-3, 0.25e-3, 0.18e-3), order: int = 2,
+                          material: Material = STEEL_304L, progress=None) -> dict:
+    """Mesh-converged crack increment of :class:`~yade_electro.fem.meshes.CrackedBarGeometry`:
+    ``convergence`` (a :class:`Convergence` of the increment over ``hs``, P``order`` elements,
+    expected order 1: the potential near the front goes as r^(1/2)), ``closed_form``
+    (:func:`edge_crack_increment`) and the runs (``runs``: one dict per h).
+    ``progress(msg)`` is called before each mesh."""
+    from .convergence import richardson
+    from .meshes import CrackedBarGeometry
+    g = CrackedBarGeometry() if geometry is None else geometry
+    runs = []
+    for k, h in enumerate(hs):
+        if progress is not None:
+            progress(f"FEM P{order} h = {h * 1e3:.3g} mm ({k + 1}/{len(hs)})")
+        runs.append(cracked_bar(g, h, material, order))
+    conv = richardson([r["h"] for r in runs], [r["increment"] for r in runs], expected_order=1.0)
+    return {"convergence": conv, "closed_form": edge_crack_increment(g.width, g.length, g.crack_depth),
+            "runs": runs}
