@@ -17,9 +17,9 @@ test: install
 test-fast:
 	@$(PYTEST) -m "not yade and not liggghts" --ignore=tests/test_install.py tests; rc=$$?; [ $$rc -ne 5 ] || $(NO_TESTS); exit $$rc
 
-# rod validation case (paper 000, section 3)
+# rod validation case (paper 000, section 3): both laws side by side
 demo: install
-	$(YADE) -n -x cases/rod_resistance.py --n 5000
+	$(YADE) -n -x cases/rod_resistance.py --n 5000 --demo
 
 bench: install
 	@set -e; ls bench/*.py >/dev/null 2>&1 || { echo "error: no bench/*.py scripts" >&2; exit 1; }; \

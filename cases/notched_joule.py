@@ -104,7 +104,9 @@ DENSITY, SPECIFIC_HEAT, CONDUCTIVITY = 7900.0, 500.0, 15.0   # 304L
 T0 = 293.15            # K
 VOLTAGE, T_END = 1.0, 0.01
 SIZES = (5000, 10000, 20000, 40000)
-LAWS = ("continuum", "voronoi")
+LAWS = ("continuum", "voronoi", "voronoi-surface")
+#: a "law" of the sweep: the conductance law, with "-surface" for electrodes on the end faces
+#: themselves (surface electrodes, see yade_electro.boundary) instead of element layers
 FEM_HS = (0.1e-3, 0.05e-3, 0.025e-3)
 #: Paper 000 figure 12 / text: (N, r_mean [um]); errors [%]: resistance 9.2 (5k) -> 6.7 (40k),
 #: notch temperature ~12 (5k), 5.8 (10k), "around 7" (20k, 40k)
@@ -241,10 +243,17 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     ids = np.asarray(P.add_bonded_packing(packing))
     r_mean = float(np.mean(packing.radii))
     end0, end1 = end_layers(packing.centers[:, 0], packing.radii, r_mean, gap)
+    label, surface = law, law.endswith("-surface")
+    law = law[:-len("-surface")] if surface else law
     law_params = {"container": shape} if law == "voronoi" else None
+    if surface:
+        box = P.Box((0, 0, 0), (LENGTH, WIDTH, THICKNESS))
+        electrodes = {"end1": dict(surface=box.face("x+"), potential=voltage),
+                      "end0": dict(surface=box.face("x-"), potential=0.0)}
+    else:
+        electrodes = {"end1": dict(select=ids[end1], potential=voltage), "end0": dict(select=ids[end0], potential=0.0)}
     engine = ElectroThermalEngine(
-        RHO_E, {"end1": dict(select=ids[end1], potential=voltage),
-                "end0": dict(select=ids[end0], potential=0.0)},
+        RHO_E, electrodes,
         density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY, temperature=T0,
         beta=0.0, eta=1.0, theta="backward-euler", thermal_dt=t_end / nsteps, law=law,
         law_params=law_params, solver=solver, iterPeriod=1,
@@ -258,7 +267,7 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     g = engine.graph
     pos, V, T = g.pos, engine.potential.copy(), engine.temperature.copy()
     sol = engine.solution
-    live = ~np.asarray(sol.floating, dtype=bool)   # unbonded elements carry nothing: left out
+    live = ~np.asarray(sol.floating[:g.n_nodes], dtype=bool)   # unbonded elements carry nothing: left out
     c = 0.5 * LENGTH
     a, b = notch_region()
     slab = live & (np.abs(pos[:, 0] - c) <= 2.0 * r_mean)
@@ -271,12 +280,14 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     right = slab & (pos[:, 0] >= c)
     dVdx = float((np.mean(V[right]) - np.mean(V[left])) / (2.0 * r_mean))
     out = {"case": "notched_joule", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed),
-           "law": law, "capacity": capacity["capacity"], "r_mean": r_mean,
+           "law": label, "electrodes": "surface" if surface else "layers", "capacity": capacity["capacity"],
+           "r_mean": r_mean,
            "cell_volume_sum": capacity.get("cell_volume_sum"), "n_bad_cells": capacity["n_bad_cells"],
            "container_volume": float(packing.container_volume),
            "r_mean_eq1": float(packing.r_mean_requested),
            "volume_fraction": float(packing.volume_fraction),
-           "n_end0": int(end0.sum()), "n_end1": int(end1.sum()),
+           "n_end0": int(end0.sum()) if not surface else int(engine.model.surfaces["end0"].saved.ids.size),
+           "n_end1": int(end1.sum()) if not surface else int(engine.model.surfaces["end1"].saved.ids.size),
            "n_slab": int(slab.sum()), "n_notch": int(notch.sum()), "n_floating": int((~live).sum()),
            "R_eq": float(engine.equivalent_resistance),
            "T_slab": float(np.mean(T[slab])), "T_notch": float(np.mean(T[notch])),

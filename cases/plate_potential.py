@@ -91,7 +91,9 @@ THICKNESS = 3.8e-3     # m, z
 SOURCE_DIAMETER = 6e-3  # m (paper 000)
 RHO_304L = 0.73e-6     # ohm m (the potentials do not depend on it)
 SIZES = (5000, 10000, 20000)
-LAWS = ("continuum", "voronoi")
+LAWS = ("continuum", "voronoi", "voronoi-surface")
+#: a "law" of the sweep: the conductance law, with "-surface" for electrodes on the hole and
+#: the bottom face themselves (surface electrodes) instead of element layers
 #: Paper 000 section 3.2: (N, r_mean [um]); errors "<= 4.2 %, mainly around 2 %" (figure 9)
 PAPER = {5000: 408, 10000: 323, 20000: 257}
 PAPER_MAX_ERROR_PCT = 4.2
@@ -121,6 +123,22 @@ def control_points() -> dict:
     return {k: tuple(v) for k, v in plate_geometry().control_points().items()}
 
 
+def hole_surface(tol=0.3 * SOURCE_DIAMETER / 2):
+    """The source hole's surface as a surface selector: boundary faces within ``tol`` [m] of
+    the hole's cylinder whose outward normal points into the hole (a concave wall is met by
+    tangent planes, whose faces lie up to s^2 / (2 R) inside it, s their size)."""
+    from yade_electro.geometry import SurfaceSelector
+    c = np.array([WIDTH / 2, HEIGHT / 2])
+    R = SOURCE_DIAMETER / 2
+
+    def on_hole(points, normals):
+        d = points[:, :2] - c
+        rho = np.hypot(d[:, 0], d[:, 1])
+        inward = -np.einsum("ij,ij->i", d, normals[:, :2]) / np.maximum(rho, 1e-300)
+        return (np.abs(rho - R) <= tol) & (inward > 0.5)
+    return SurfaceSelector(on_hole, "the source hole's surface")
+
+
 def electrode_layers(pos, r, r_mean, gap=0.1):
     """Masks (ground, source) of the electrode layers (see module doc)."""
     ground = (pos[:, 1] - r) <= gap * r_mean
@@ -131,17 +149,11 @@ def electrode_layers(pos, r, r_mean, gap=0.1):
 
 def control_point_value(pos, potential, point, r_mean, fit_radius=2.5, min_points=6):
     """Linear least-squares fit of element potentials around the line through ``point``
-    along z, evaluated at ``point`` (see module doc). Returns (value, n_used)."""
-    p = np.asarray(point, dtype=float)
-    d = np.hypot(pos[:, 0] - p[0], pos[:, 1] - p[1])
-    sel = d <= fit_radius * r_mean
-    k = int(sel.sum())
-    if k < min_points:
-        raise ValueError(f"only {k} elements within {fit_radius} r_mean of {tuple(p)}; "
-                         f"increase fit_radius")
-    X = np.column_stack([np.ones(k), pos[sel] - p])
-    coef, *_ = np.linalg.lstsq(X, potential[sel], rcond=None)
-    return float(coef[0]), k
+    along z, evaluated at ``point`` (see module doc; ``yade_electro.probes.probe``).
+    Returns (value, n_used)."""
+    from yade_electro.probes import probe
+    out = probe(pos, potential, point, fit_radius * r_mean, axis=(0, 0, 1), min_points=min_points)
+    return float(out.value[0]), int(out.n_used[0])
 
 
 def fem_reference(offset: float = 0.0, hs=FEM_HS, voltage=1.0) -> dict:
@@ -199,20 +211,25 @@ def run_plate(n=5000, seed=1, law="continuum", voltage=1.0, gap=0.1, fit_radius=
     ids = np.asarray(P.add_bonded_packing(packing))
     r_mean = float(np.mean(packing.radii))
     ground, source = electrode_layers(packing.centers, packing.radii, r_mean, gap)
+    label, surface = law, law.endswith("-surface")
+    law = law[:-len("-surface")] if surface else law
     law_params = {"container": shape} if law == "voronoi" else None
-    engine = ElectricalEngine(RHO_304L, {"source": dict(select=ids[source], potential=voltage),
-                                         "ground": dict(select=ids[ground], potential=0.0)},
-                              law=law, law_params=law_params, solver=solver, iterPeriod=1,
+    if surface:
+        electrodes = {"source": dict(surface=hole_surface(), potential=voltage),
+                      "ground": dict(surface=P.Box((0, 0, 0), (WIDTH, HEIGHT, THICKNESS)).face("y-"), potential=0.0)}
+    else:
+        electrodes = {"source": dict(select=ids[source], potential=voltage), "ground": dict(select=ids[ground], potential=0.0)}
+    engine = ElectricalEngine(RHO_304L, electrodes, law=law, law_params=law_params, solver=solver, iterPeriod=1,
                               label="plate")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
     O.step()
     t_solve = time.perf_counter() - t1
     g, sol = engine.graph, engine.solution
-    pos, pot = g.pos, sol.potential
-    live = ~np.asarray(sol.floating, dtype=bool)   # unbonded elements: no potential, left out
+    pos, pot = g.pos, engine.potential
+    live = ~np.asarray(sol.floating[:g.n_nodes], dtype=bool)   # unbonded elements: no potential, left out
     out = {"case": "plate_potential", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed),
-           "law": law, "r_mean": r_mean, "r_mean_eq1": float(packing.r_mean_requested),
+           "law": label, "electrodes": "surface" if surface else "layers", "r_mean": r_mean, "r_mean_eq1": float(packing.r_mean_requested),
            "volume_fraction": float(packing.volume_fraction),
            "n_ground": int(ground.sum()), "n_source": int(source.sum()), "n_floating": int((~live).sum()),
            "R_eq": float(engine.equivalent_resistance),

@@ -19,6 +19,12 @@ Run
     yade-electro -n -x cases/rod_resistance.py --n 5000 --seed 1         # one packing
     yade-electro -n -x cases/rod_resistance.py --sweep                     # Table III: 5 sizes x 3 seeds
     yade-electro batch cases/rod_resistance.table cases/rod_resistance.py  # the same through yade-batch
+    yade-electro -n -x cases/rod_resistance.py --law voronoi --electrodes surface --sweep --sizes 5000,20000
+
+Surface electrodes (``--electrodes surface``, law ``voronoi``): the electrodes are the end
+faces themselves (each element whose bounded Voronoi cell has a face on an end face joins
+its electrode through its half cell), and R_dem is compared with the nominal
+rho_e L / (pi R^2), no L_eff.
 
 The script ends by printing one line of JSON with its figures. It is also importable
 (``run_rod``) by the tests.
@@ -69,10 +75,16 @@ def end_layers(z, r, r_mean, gap=0.1, length=LENGTH):
 
 
 def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_params=None, solver="cg",
-            gap=0.1, detection_factor=None, cache_dir=None, history=None, elements_csv=None):
+            gap=0.1, detection_factor=None, cache_dir=None, history=None, elements_csv=None, electrodes="layers"):
     """Build (or load from the cache) the bonded rod in YADE, solve it with the electrical
     engine, and return a dict of figures (n, r_mean, R_dem, R_th, error_pct, packing stats,
-    timings). Resets YADE's scene first."""
+    timings). Resets YADE's scene first. ``electrodes='layers'``: the paper's element layers,
+    against R_th = rho (L - 2 r_mean) / (pi R^2); ``'surface'``: electrodes on the end faces
+    themselves (needs the 'voronoi' law), against the nominal rho L / (pi R^2)."""
+    if electrodes not in ("layers", "surface"):
+        raise ValueError(f"electrodes must be 'layers' or 'surface', got {electrodes!r}")
+    if electrodes == "surface" and law != "voronoi":
+        raise ValueError("surface electrodes need the 'voronoi' law (its cells give the end faces): --law voronoi")
     yade = import_yade()
     from yade import pack
     from yade_electro.yade import ElectricalEngine
@@ -95,9 +107,13 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     z, r = packing.centers[:, 2], packing.radii
     bottom, top = end_layers(z, r, r_mean, gap)
     ids = np.asarray(ids)
-    engine = ElectricalEngine(rho, {"top": dict(select=ids[top], potential=voltage),
-                                    "bottom": dict(select=ids[bottom], potential=0.0)},
-                              law=law, law_params=law_params, solver=solver, iterPeriod=1,
+    if electrodes == "surface":
+        rod = P.as_shape(container)
+        spec = {"top": dict(surface=rod.face("top"), potential=voltage),
+                "bottom": dict(surface=rod.face("bottom"), potential=0.0)}
+    else:
+        spec = {"top": dict(select=ids[top], potential=voltage), "bottom": dict(select=ids[bottom], potential=0.0)}
+    engine = ElectricalEngine(rho, spec, law=law, law_params=law_params, solver=solver, iterPeriod=1,
                               history=history, label="rod")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
@@ -107,23 +123,25 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     from yade_electro.surfaces import eccentricity
     e = eccentricity(g)
     R_dem = engine.equivalent_resistance
-    R_th = theoretical_resistance(r_mean, rho)
+    R_th = theoretical_resistance(r_mean, rho) if electrodes == "layers" else rho * LENGTH / (math.pi * RADIUS ** 2)
     sol = engine.solution
     engine.remove()
     if elements_csv is not None:        # per-element results
         np.savetxt(elements_csv,
-                   np.column_stack([g.ids, g.pos, g.radius, g.degree, e, sol.potential]),
+                   np.column_stack([g.ids, g.pos, g.radius, g.degree, e, engine.potential]),
                    delimiter=",", header="body_id,x,y,z,radius,neighbours,eccentricity,potential",
                    comments="", fmt=["%d", "%.9e", "%.9e", "%.9e", "%.9e", "%d", "%.6f", "%.9e"])
     return {
         "case": "rod_resistance", "n": int(g.n_nodes), "n_target": int(n), "seed": int(seed), "law": law,
+        "electrodes": electrodes,
         "detection_factor": detection_factor,
         "r_mean": r_mean, "R_dem": float(R_dem), "R_th": float(R_th),
         "error_pct": float(100.0 * (R_dem - R_th) / R_th),
         "volume_fraction": float(np.sum(4.0 / 3.0 * np.pi * r ** 3) / (math.pi * RADIUS ** 2 * LENGTH)),
         "mean_coordination": float(np.mean(g.degree)),
         "frac_e_below_0.4": float(np.mean(e < 0.4)),
-        "n_bottom": int(bottom.sum()), "n_top": int(top.sum()),
+        "n_bottom": int(bottom.sum()) if electrodes == "layers" else int(engine.model.surfaces["bottom"].saved.ids.size),
+        "n_top": int(top.sum()) if electrodes == "layers" else int(engine.model.surfaces["top"].saved.ids.size),
         "current_imbalance": float(sol.current_imbalance), "residual": float(sol.residual),
         "t_packing_s": t_pack, "t_step_s": t_solve,
     }
@@ -133,7 +151,8 @@ def sweep(sizes=SIZES, seeds=SEEDS, out_dir="out/rod_resistance", law="continuum
     """Table III: every size x seed; writes a CSV and a PNG like figure 7; returns the rows."""
     os.makedirs(out_dir, exist_ok=True)
     rows = []
-    csv_path = os.path.join(out_dir, f"rod_resistance_{law}.csv")
+    tag = law if kw.get("electrodes", "layers") == "layers" else f"{law}_surface"
+    csv_path = os.path.join(out_dir, f"rod_resistance_{tag}.csv")
     import csv
     with open(csv_path, "w", newline="") as fh:
         w = None
@@ -149,7 +168,7 @@ def sweep(sizes=SIZES, seeds=SEEDS, out_dir="out/rod_resistance", law="continuum
                 print(f"N={n:6d} seed={s} n={row['n']:6d} r_mean={row['r_mean'] * 1e6:6.1f} um "
                       f"R_dem={row['R_dem'] * 1e3:.4f} mohm R_th={row['R_th'] * 1e3:.4f} mohm "
                       f"error={row['error_pct']:+.2f} %", flush=True)
-    plot_sweep(rows, os.path.join(out_dir, f"rod_resistance_{law}.png"))
+    plot_sweep(rows, os.path.join(out_dir, f"rod_resistance_{tag}.png"))
     return rows
 
 
@@ -203,31 +222,60 @@ def _params(argv):
     ap.add_argument("--law", default="continuum")
     ap.add_argument("--solver", default="cg")
     ap.add_argument("--gap", type=float, default=0.1, help="electrode layer: z - r <= gap r_mean")
+    ap.add_argument("--electrodes", choices=("layers", "surface"), default="layers",
+                    help="element layers (the paper's, against L - 2 r_mean) or the end faces (nominal L)")
     ap.add_argument("--k", type=float, default=None,
                     help="bond detection factor (default that of add_bonded_packing, 1.04)")
     ap.add_argument("--sweep", action="store_true", help="all sizes x 3 seeds (Table III)")
+    ap.add_argument("--demo", action="store_true",
+                    help="the paper's continuum law and the voronoi law (element layers and end faces) side by side")
     ap.add_argument("--sizes", type=lambda s: tuple(int(x) for x in s.split(",")), default=SIZES)
     ap.add_argument("--out", default="out/rod_resistance")
     args = ap.parse_args(argv)
     return apply_batch_table(args)      # under yade-batch, the table line gives n, seed, law
 
 
+def demo(n=5000, seed=1, solver="cg", gap=0.1):
+    """The laws side by side on one packing: the paper's continuum law and the voronoi law
+    with element-layer electrodes (against L - 2 r_mean), the voronoi law with the end faces
+    as electrodes (against the nominal L). Prints a table; returns the rows."""
+    rows = [run_rod(n, seed, law=law, solver=solver, gap=gap, electrodes=el)
+            for law, el in (("continuum", "layers"), ("voronoi", "layers"), ("voronoi", "surface"))]
+    print(f"rod R = {RADIUS * 1e3:g} mm, L = {LENGTH * 1e3:g} mm, {rows[0]['n']} elements "
+          f"(r_mean {rows[0]['r_mean'] * 1e6:.1f} um), 1 V:")
+    print(f"  {'law':<22} {'electrodes':<15} {'R_dem [mohm]':>12}  {'theory [mohm]':<24} {'error':>8}")
+    for r in rows:
+        el = "element layers" if r["electrodes"] == "layers" else "end faces"
+        th = "L - 2 r_mean" if r["electrodes"] == "layers" else "L"
+        name = "continuum (paper 000)" if r["law"] == "continuum" else "voronoi"
+        theory = f"{r['R_th'] * 1e3:.5f} ({th})"
+        print(f"  {name:<22} {el:<15} {r['R_dem'] * 1e3:12.5f}  {theory:<24} {r['error_pct']:+7.2f} %")
+    return rows
+
+
 def main(argv=None):
     args = _params(sys.argv[1:] if argv is None else argv)
+    if args.demo:
+        rows = demo(args.n, args.seed, args.solver, args.gap)
+        summary = {"case": "rod_resistance", "demo": True, "n": rows[0]["n"], "rows": [
+            {k: r[k] for k in ("law", "electrodes", "R_dem", "R_th", "error_pct")} for r in rows]}
+        print(json.dumps(summary))
+        return summary
     if args.sweep:
         rows = sweep(args.sizes, SEEDS, args.out, law=args.law, solver=args.solver, gap=args.gap,
-                     detection_factor=args.k)
+                     detection_factor=args.k, electrodes=args.electrodes)
         print(table_markdown(rows))
-        summary = {"case": "rod_resistance", "law": args.law, "rows": [
+        summary = {"case": "rod_resistance", "law": args.law, "electrodes": args.electrodes, "rows": [
             {k: r[k] for k in ("n", "n_target", "seed", "r_mean", "R_dem", "R_th", "error_pct")} for r in rows]}
         for n in sorted({r["n_target"] for r in rows}):
             summary[f"mean_error_pct_{n}"] = float(np.mean([r["error_pct"] for r in rows if r["n_target"] == n]))
         print(json.dumps(summary))
         return summary
     os.makedirs(args.out, exist_ok=True)
-    stem = os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}")
+    stem = os.path.join(args.out, f"rod_n{args.n}_s{args.seed}_{args.law}"
+                        + ("" if args.electrodes == "layers" else "_surface"))
     row = run_rod(args.n, args.seed, law=args.law, solver=args.solver, gap=args.gap, detection_factor=args.k,
-                  history=stem + "_history.csv", elements_csv=stem + "_elements.csv")
+                  history=stem + "_history.csv", elements_csv=stem + "_elements.csv", electrodes=args.electrodes)
     with open(stem + ".json", "w") as fh:
         json.dump(row, fh)
     plot_profile(stem + "_elements.csv", row, stem + ".png")
@@ -241,14 +289,14 @@ def main(argv=None):
 
 def plot_profile(elements_csv, row, path):
     """Element potentials along the rod axis against the linear theory between the electrode
-    planes (z = r_mean and z = L - r_mean)."""
+    planes (z = r_mean and z = L - r_mean; with surface electrodes the end faces)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     d = np.genfromtxt(elements_csv, delimiter=",", names=True)
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(d["z"] * 1e3, d["potential"], ".", ms=2, alpha=0.4, label="elements")
-    rm = row["r_mean"]
+    rm = row["r_mean"] if row.get("electrodes", "layers") == "layers" else 0.0
     ax.plot([rm * 1e3, (LENGTH - rm) * 1e3], [0, 1], "k-", lw=1, label="uniform field (theory)")
     ax.set_xlabel("z [mm]")
     ax.set_ylabel("potential [V]")

@@ -1,7 +1,6 @@
 """Live runs in real YADE: save / load (same and new process) continuing exactly, several
 engines, every setup error raised in the script, cheap change detection, and no open port."""
 import csv
-import json
 
 import numpy as np
 import pytest

@@ -20,7 +20,10 @@ from .solvers import make_solver, solver_names, DirectSolver, CGSolver, Deflated
 from .history import History
 from .electrical import ElectricalModel, ElectrodeSpec
 from .thermal import (heat_capacity, thermal_conductance, joule_sources, HeatSolver, FixedTemperature,
-                      HeatFlux, Convection)
+                      HeatFlux, Convection, HeatSource, SteadyHeat)
 from .coupled import ElectroThermalModel
+from .boundary import boundary_areas, surface_contact, SurfaceContact
+from .geometry import Box, Cylinder, Sphere, Plane, as_shape
+from .probes import probe, line_probe, plane_probe, section_mean, region_mean, slab_means, element_gradients
 
 __version__ = "0.2.0"

@@ -28,12 +28,13 @@ import numpy as np
 from .errors import BoundaryConditionError
 from .geometry import as_surface
 
-__all__ = ["SurfaceContact", "surface_contact", "boundary_areas", "BoundaryOfGraph"]
+__all__ = ["SurfaceContact", "surface_contact", "SavedSurface", "SurfaceMembership", "check_surface", "boundary_areas",
+           "BoundaryOfGraph"]
 
 
 @dataclass(frozen=True, eq=False)
 class SurfaceContact:
-    """The elements a surface touches.
+    """The elements a surface touches, and through which boundary faces.
 
     Attributes
     ----------
@@ -42,6 +43,8 @@ class SurfaceContact:
     area : (k,) boundary-face area of each on the surface [m^2]
     factor : (k,) half-cell geometric factor sum_f A_f / d_f [m]
     depth : (k,) area-weighted distance from the centre to the surface [m]
+    face_area, face_depth : (f,) each boundary face's area [m^2] and distance d_f [m]
+    face_slot : (f,) the position in ``nodes`` of each face's element
     """
 
     name: str
@@ -49,22 +52,36 @@ class SurfaceContact:
     area: np.ndarray
     factor: np.ndarray
     depth: np.ndarray
+    face_area: np.ndarray
+    face_depth: np.ndarray
+    face_slot: np.ndarray
 
     @property
     def total_area(self) -> float:
         return float(self.area.sum())
 
     def convection_area(self, h, conductivity) -> np.ndarray:
-        """Area A_eff with h A_eff = sum_f A_f / (1/h + d_f / lambda): convection in series with
-        the half cell (per element, lambda its conductivity)."""
-        lam = np.broadcast_to(np.asarray(conductivity, float), self.nodes.shape) if np.ndim(conductivity) == 0 \
-            else np.asarray(conductivity, float)[self.nodes]
-        return self._per_node(lambda a, d, k: a / (1.0 + h * d / lam[k]))
+        """Per element, the area A_eff [m^2] with h A_eff = sum_f A_f / (1/h + d_f / lambda):
+        convection ``h`` [W/(m^2 K)] in series with the half cell (``conductivity`` lambda
+        [W/(m K)], a scalar or one per element of the graph)."""
+        lam = np.asarray(conductivity, float)
+        lam = np.broadcast_to(lam, self.nodes.shape) if lam.ndim == 0 else lam[self.nodes]
+        k = self.face_slot
+        return np.bincount(k, self.face_area / (1.0 + h * self.face_depth / lam[k]), self.nodes.size)
 
-    def _per_node(self, fn):
-        a, d, owner = self._faces
-        k = np.searchsorted(self.nodes, owner)
-        return np.bincount(k, fn(a, d, k), self.nodes.size)
+    def moved_to(self, nodes, keep=None) -> "SurfaceContact":
+        """The same contact on another element numbering: ``nodes[s]`` is the new index of
+        the element in slot s; ``keep`` (bool per slot) drops elements that are gone."""
+        nodes = np.asarray(nodes, dtype=np.int64)
+        keep = np.ones(self.nodes.size, bool) if keep is None else np.asarray(keep, bool)
+        order = np.argsort(nodes[keep])
+        old_slots = np.flatnonzero(keep)[order]
+        new_slot = np.full(self.nodes.size, -1, dtype=np.int64)
+        new_slot[old_slots] = np.arange(old_slots.size)
+        f = new_slot[self.face_slot] >= 0
+        return SurfaceContact(self.name, nodes[old_slots], self.area[old_slots], self.factor[old_slots],
+                              self.depth[old_slots], self.face_area[f], self.face_depth[f],
+                              new_slot[self.face_slot[f]])
 
 
 def surface_contact(cells, pos, surface, name: str = "surface", what: str = "electrode") -> SurfaceContact:
@@ -73,7 +90,7 @@ def surface_contact(cells, pos, surface, name: str = "surface", what: str = "ele
     BoundaryConditionError when it touches none."""
     sel = as_surface(surface)
     pos = np.asarray(pos, float)
-    on = sel(cells.boundary_point, cells.boundary_normal)
+    on = np.asarray(sel(cells.boundary_point, cells.boundary_normal), bool)
     if not np.any(on):
         raise BoundaryConditionError(
             f"{what} {name!r}: the surface {sel!r} holds none of the packing's boundary faces (it is not on the "
@@ -83,16 +100,74 @@ def surface_contact(cells, pos, surface, name: str = "surface", what: str = "ele
     area = cells.boundary_area[on]
     d = np.abs(np.einsum("ij,ij->i", cells.boundary_point[on] - pos[owner], cells.boundary_normal[on]))
     # an element centred on the surface itself: a thin half cell, never a zero one
-    r_floor = 1e-3 * np.sqrt(area)
-    d = np.maximum(d, r_floor)
+    d = np.maximum(d, 1e-3 * np.sqrt(area))
     nodes = np.unique(owner)
     k = np.searchsorted(nodes, owner)
     A = np.bincount(k, area, nodes.size)
     g = np.bincount(k, area / d, nodes.size)
     depth = np.bincount(k, area * d, nodes.size) / A
-    out = SurfaceContact(name, nodes, A, g, depth)
-    object.__setattr__(out, "_faces", (area, d, owner))
-    return out
+    return SurfaceContact(name, nodes, A, g, depth, area, d, k)
+
+
+@dataclass(frozen=True, eq=False)
+class SavedSurface:
+    """A surface already resolved on a packing, by body id: what an engine saves with the
+    scene (the surface selectors themselves hold functions, which cannot be saved). It is
+    accepted wherever a surface is."""
+
+    ids: np.ndarray
+    contact: SurfaceContact
+
+    def __repr__(self):
+        return f"SavedSurface({self.contact.name!r}, {self.ids.size} elements)"
+
+
+class SurfaceMembership:
+    """Which elements a surface condition acts on: resolved on the first graph from the
+    bounded cells, then kept by element id (elements that are gone drop out; an error when
+    none is left). ``saved`` gives what to keep with a scene."""
+
+    def __init__(self, name: str, surface, what: str = "electrode"):
+        self.name, self.what = name, what
+        self.surface = surface
+        self._ids, self._contact = (surface.ids, surface.contact) if isinstance(surface, SavedSurface) else (None, None)
+
+    @property
+    def resolved(self) -> bool:
+        return self._ids is not None
+
+    @property
+    def saved(self) -> SavedSurface:
+        if self._ids is None:
+            raise BoundaryConditionError(f"{self.what} {self.name!r}: not resolved on a packing yet")
+        return SavedSurface(self._ids, self._contact)
+
+    def contact(self, graph, boundary) -> SurfaceContact:
+        """The contact on ``graph`` (``boundary``: a BoundaryOfGraph, used the first time)."""
+        if self._ids is None:
+            if boundary is None:
+                raise BoundaryConditionError(f"{self.what} {self.name!r} is a surface: it needs the solid's container "
+                                             "(container=<the Shape>)")
+            cells, pos = boundary.cells(graph)
+            c = surface_contact(cells, pos, self.surface, self.name, self.what)
+            self._ids, self._contact = graph.ids[c.nodes].copy(), c
+            return c
+        present = np.isin(self._ids, graph.ids)
+        if not np.any(present):
+            raise BoundaryConditionError(f"{self.what} {self.name!r}: none of its elements is left in the packing")
+        nodes = np.full(self._ids.size, -1, dtype=np.int64)
+        nodes[present] = graph.index_of(self._ids[present])
+        return self._contact.moved_to(nodes, present)
+
+
+def check_surface(surface, what: str):
+    """Raise BoundaryConditionError unless ``surface`` is something a surface condition takes."""
+    if isinstance(surface, SavedSurface):
+        return
+    try:
+        as_surface(surface)
+    except ValueError as exc:
+        raise BoundaryConditionError(f"{what}: {exc}") from None
 
 
 def boundary_areas(cells, n: int):

@@ -42,8 +42,9 @@ from .graph import ContactGraph
 from .history import History
 from .materials import Material, edge_conductivity, real_number
 from .selection import Membership
-from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, diffusion_time_step, heat_capacity,
-                      theta_of)
+from .boundary import BoundaryOfGraph, SurfaceMembership
+from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, HeatSource, diffusion_time_step,
+                      heat_capacity, theta_of)
 
 __all__ = ["ElectroThermalModel"]
 
@@ -77,7 +78,14 @@ class ElectroThermalModel:
         Passed to :class:`HeatSolver` (``thermal_solver`` is its ``solver``).
     fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
         Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
-        on the first graph and then kept by element id.
+        on the first graph and then kept by element id; or ``surface=`` a surface of the
+        ``container`` (see :mod:`yade_electro.boundary`): a fixed temperature then acts through
+        the touching elements' half cells, a flux on their boundary faces' areas, convection
+        on those areas in series with the half cells.
+    sources : sequence of HeatSource, optional
+        Heat sources inside the solid [W or W/m^3], shared by element volume.
+    container : Shape, optional
+        The solid, for surface conditions (default: the electrical model's, or the law's).
     area : callable(graph) -> (n,) exposed areas [m^2], optional
         Default area of convection/flux conditions (else ``thermal.exposed_area``).
     volume_fraction, cell_volume : optional, see :func:`~yade_electro.thermal.heat_capacity`
@@ -95,7 +103,8 @@ class ElectroThermalModel:
                  max_substeps: int = 100000, thermal_solver="cg", fixed: Sequence[FixedTemperature] = (),
                  flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), area=None,
                  volume_fraction=None, cell_volume=None, coupling_iterations: int = 0, coupling_tol: float = 1e-10,
-                 resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None):
+                 resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None,
+                 sources: Sequence[HeatSource] = (), container=None):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.electrical) or None")
         self.electrical = electrical
@@ -123,9 +132,31 @@ class ElectroThermalModel:
         if len(set(names)) != len(names):
             from .errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
-        self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition") for b in self.fixed + self.flux + self.convection}
+        self.heat_sources = list(sources)
+        for src in self.heat_sources:
+            if not isinstance(src, HeatSource):
+                raise TypeError(f"expected HeatSource objects, got {src!r}")
+        names += [src.name for src in self.heat_sources]
+        if len(set(names)) != len(names):
+            from .errors import BoundaryConditionError
+            raise BoundaryConditionError(f"thermal boundary condition and heat source names must be unique, got {names}")
+        everything = self.fixed + self.flux + self.convection
+        self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition")
+                               for b in everything if b.surface is None}
+        self.bc_memberships.update({src.name: Membership(src.name, src.nodes, what="heat source")
+                                    for src in self.heat_sources if src.nodes is not None})
+        self.bc_surfaces = {b.name: SurfaceMembership(b.name, b.surface, what="thermal boundary condition")
+                            for b in everything if b.surface is not None}
         self.network = electrical.network if electrical is not None else FactorNetwork(
             make_law(law, **dict(law_params or {})))
+        if container is None and electrical is not None:
+            container = electrical.container
+        if container is None:
+            container = getattr(self.network.law, "container", None)
+        self.container = container
+        self._boundary = None
+        if any(not m.resolved for m in self.bc_surfaces.values()):
+            self._boundary = BoundaryOfGraph(container, self.network.law)
         if cell_volume is None and volume_fraction is None and hasattr(self.network.law, "cell_volumes"):
             # the capacities that go with Voronoi conductances: the cells fill the solid
             cell_volume = self.network.law.cell_volumes
@@ -142,7 +173,7 @@ class ElectroThermalModel:
         self._rho_solved = None     # per-node resistivity of the last potential solve
         self._sol_id = None
         self.solution = None
-        self.sources = None
+        self.sources = None         # per-element Joule sources of the last potential [W]
         self._time0, self._energy0 = 0.0, None
 
     # -- one owner: time and energy are the heat solver's ------------------------------------
@@ -210,10 +241,25 @@ class ElectroThermalModel:
         elif self._T_restore is not None:
             T = self._T_restore(graph)
         nodes_of = {name: m.nodes(graph) for name, m in self.bc_memberships.items()}
+        area_of, link_of = {}, {}
+        lam = np.asarray(self.material.conductivity, dtype=float)
+        for b in self.fixed + self.flux + self.convection:
+            if b.surface is None:
+                continue
+            contact = self.bc_surfaces[b.name].contact(graph, self._boundary)
+            nodes_of[b.name] = contact.nodes
+            if isinstance(b, FixedTemperature):
+                link_of[b.name] = (lam if lam.ndim == 0 else lam[contact.nodes]) * contact.factor
+            elif isinstance(b, Convection):
+                area_of[b.name] = contact.convection_area(b.h, lam)
+            else:
+                area_of[b.name] = contact.area
+        capacity = self._capacities(graph)
         area = self.area(graph) if callable(self.area) else self.area
-        self.heat = HeatSolver(self._capacities(graph), self.network.edges, self._thermal_conductance(graph), T,
+        self.heat = HeatSolver(capacity, self.network.edges, self._thermal_conductance(graph), T,
                                fixed=self.fixed, flux=self.flux, convection=self.convection, time=time,
-                               energy=energy, graph=graph, area=area, nodes_of=nodes_of, coords=graph.pos,
+                               energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
+                               link_of=link_of, power=self._source_power(graph), coords=graph.pos,
                                **self.heat_options)
         self._ids = graph.ids.copy()
         self._rho_solved = None
@@ -222,6 +268,25 @@ class ElectroThermalModel:
                   graph.n_nodes, self.network.edges.shape[0], self.heat.critical_time_step)
 
     _T_restore = None
+
+    def _volumes(self, graph):
+        """The volume each element stands for [m^3] (what its heat capacity is made of)."""
+        return self._capacities(graph) / (np.asarray(self.material.density, float)
+                                          * np.asarray(self.material.specific_heat, float))
+
+    def _source_power(self, graph):
+        if not self.heat_sources:
+            return None
+        vol = self._volumes(graph)
+        q = np.zeros(graph.n_nodes)
+        for src in self.heat_sources:
+            nodes = self.bc_memberships[src.name].nodes(graph) if src.nodes is not None else np.arange(graph.n_nodes)
+            v = vol[nodes]
+            if src.power is not None:
+                np.add.at(q, nodes, src.power * v / v.sum())
+            else:
+                np.add.at(q, nodes, src.density * v)
+        return q
 
     def restore_temperatures(self, fn):
         """Temperatures of the first graph from ``fn(graph) -> (n,)`` (a resumed run)."""
@@ -292,6 +357,41 @@ class ElectroThermalModel:
         self._set_resistivity(self.heat.temperature)
         self._solve_potential()
         return self.summary()
+
+    def steady_state(self, graph: ContactGraph, max_iterations: int = 50) -> dict:
+        """The steady temperatures on ``graph`` (they replace the current ones; the clock does
+        not move): potential, Joule sources, then the steady heat balance with every boundary
+        condition and heat source. With rho_e(T) (``beta != 0``) the potential and the
+        temperatures are iterated (fixed point) until the sources change by less than
+        ``coupling_tol`` (relative), at most ``max_iterations`` times (a warning if not: a
+        thermal runaway has no steady state). Returns the history row, with
+        ``steady_iterations`` and ``steady_balance_error`` (|sum of powers| / max power)."""
+        self.prepare(graph)
+        heat = self.heat
+        self._set_resistivity(heat.temperature)
+        src = self._solve_potential()
+        done = 0
+        for done in range(1, int(max_iterations) + 1):
+            st = heat.steady(src)
+            if self.beta == 0.0 or self.electrical is None:
+                break
+            self._set_resistivity(heat.temperature)
+            new = self._solve_potential()
+            change = np.max(np.abs(new - src)) / max(np.max(np.abs(new)), 1e-300)
+            src = new
+            if change <= self.coupling_tol:
+                st = heat.steady(src)
+                break
+        else:
+            import warnings
+            warnings.warn(f"the steady state with rho_e(T) did not converge in {max_iterations} iterations (the "
+                          "sources still change by more than coupling_tol): the temperatures are the last iterate; "
+                          "a thermal runaway has no steady state", stacklevel=2)
+        row = self.summary(None, float(np.sum(src)))
+        row.update({"steady_iterations": done, "steady_balance_error": st.balance_error})
+        if self.history is not None:
+            self.history.append(row)
+        return row
 
     # -- figures ----------------------------------------------------------------------------
     @property

@@ -63,11 +63,8 @@ class ElectrodeSpec:
             raise BoundaryConditionError(f"electrode {self.name!r}: give select= (an element layer: a predicate, ids "
                                          "or a mask) or surface= (a surface of the container), one of them")
         if self.surface is not None:
-            from .geometry import as_surface
-            try:
-                as_surface(self.surface)
-            except ValueError as exc:
-                raise BoundaryConditionError(f"electrode {self.name!r}: {exc}") from None
+            from .boundary import check_surface
+            check_surface(self.surface, f"electrode {self.name!r}")
         else:
             check_selector(self.select, f"electrode {self.name!r}: select")
         if (self.potential is None) == (self.current is None):
@@ -165,11 +162,12 @@ class ElectricalModel:
         self.memberships: Dict[str, Membership] = {s.name: Membership(s.name, s.select, reselect)
                                                    for s in self.specs if s.surface is None}
         self.container = container if container is not None else getattr(self.law, "container", None)
+        from .boundary import BoundaryOfGraph, SurfaceMembership
+        self.surfaces: Dict[str, SurfaceMembership] = {s.name: SurfaceMembership(s.name, s.surface)
+                                                       for s in self.specs if s.surface is not None}
         self._boundary = None
-        if any(s.surface is not None for s in self.specs):
-            from .boundary import BoundaryOfGraph
+        if any(not m.resolved for m in self.surfaces.values()):
             self._boundary = BoundaryOfGraph(self.container, self.law)
-        self.contacts: Dict = {}          # surface electrode name -> SurfaceContact (by id once made)
         self.values: Dict[str, float] = {s.name: s.value for s in self.specs}
         self.resistivity = self.material.resistivity
         self.network = FactorNetwork(self.law)
@@ -276,21 +274,7 @@ class ElectricalModel:
 
     def _surface_contact(self, spec, graph):
         """The elements a surface electrode touches (made once, kept by element id)."""
-        from .boundary import SurfaceContact, surface_contact
-        kept = self.contacts.get(spec.name)
-        if kept is None:
-            cells, pos = self._boundary.cells(graph)
-            contact = surface_contact(cells, pos, spec.surface, spec.name)
-            self.contacts[spec.name] = (graph.ids[contact.nodes].copy(), contact)
-            return contact
-        ids, contact = kept
-        present = np.isin(ids, graph.ids)
-        if not np.any(present):
-            raise BoundaryConditionError(f"electrode {spec.name!r}: none of its elements is left in the packing")
-        nodes = graph.index_of(ids[present])
-        order = np.argsort(nodes)
-        return SurfaceContact(spec.name, nodes[order], contact.area[present][order], contact.factor[present][order],
-                              contact.depth[present][order])
+        return self.surfaces[spec.name].contact(graph, self._boundary)
 
     def _build(self, graph: ContactGraph):
         n = graph.n_nodes

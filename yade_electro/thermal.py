@@ -62,7 +62,8 @@ from .surfaces import eccentricity, volume_fraction as _volume_fraction
 __all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
            "resolve_nodes", "resolve_area",
            "exposed_area", "stable_time_step", "diffusion_time_step", "theta_of",
-           "FixedTemperature", "HeatFlux", "Convection", "ThermalState", "HeatStep", "HeatSolver"]
+           "FixedTemperature", "HeatFlux", "Convection", "HeatSource", "ThermalState", "HeatStep", "HeatSolver",
+           "SteadyHeat"]
 
 log = logging.getLogger(__name__)
 
@@ -200,6 +201,20 @@ def _finite(name, v):
 def _check_bc(bc, kind):
     if not isinstance(bc.name, str) or not bc.name:
         raise BoundaryConditionError(f"{kind} boundary condition names must be non-empty strings, got {bc.name!r}")
+    surface = getattr(bc, "surface", None)
+    if surface is not None:
+        if bc.nodes is not None:
+            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (elements) or surface= "
+                                         "(a surface of the container), not both")
+        if getattr(bc, "area", None) is not None:
+            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: a surface condition takes its areas "
+                                         "from the boundary faces on the surface; do not give area=")
+        from .boundary import check_surface
+        check_surface(surface, f"{kind} boundary condition {bc.name!r}")
+        return
+    if bc.nodes is None:
+        raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (a selector: predicate, "
+                                     "ids, mask) or surface= (a surface of the container)")
     check_selector(bc.nodes, f"{kind} boundary condition {bc.name!r}: nodes")
     area = getattr(bc, "area", None)
     if area is not None and not callable(area):
@@ -213,38 +228,52 @@ def _check_bc(bc, kind):
                                          "(m^2), a scalar or one per element")
 
 
+def _required(bc, kind, field_, unit):
+    if getattr(bc, field_) is None:
+        raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give {field_}= ({unit})")
+
+
 @dataclass(frozen=True)
 class FixedTemperature:
-    """A node set held at ``temperature`` [K or degC, as the model].
+    """A fixed temperature [K or degC, as the model] on a node set or at a surface.
 
     ``nodes``: node indices (HeatSolver), or, when a graph is given
     (``HeatSolver.from_graph``, ``ElectroThermalModel``), anything
-    ``yade_electro.engine.select_nodes`` takes (callable, mask, graph ids)."""
+    ``yade_electro.selection.select_nodes`` takes (callable, mask, graph ids): those
+    elements are held at ``temperature``. ``surface``: a surface of the container
+    (``shape.face('top')``, see :mod:`yade_electro.boundary`; needs ``ElectroThermalModel``):
+    the surface is held at ``temperature`` and each element with boundary faces on it
+    exchanges heat with it through its half cell, ``lambda sum_f A_f / d_f`` [W/K] (the
+    finite-volume Dirichlet condition). Give one of them."""
 
     name: str
-    nodes: Any
-    temperature: float
+    nodes: Any = None
+    temperature: float = None
+    surface: Any = None
 
     def __post_init__(self):
         _check_bc(self, "fixed-temperature")
+        _required(self, "fixed-temperature", "temperature", "K")
         object.__setattr__(self, "temperature",
                            _finite(f"fixed-temperature boundary condition {self.name!r}: temperature", self.temperature))
 
 
 @dataclass(frozen=True)
 class HeatFlux:
-    """Heat fed into a node set: ``power`` [W] in total, shared in proportion to ``area`` (equal
-    shares when ``area`` is None), or ``flux`` [W/m^2] times each node's ``area``. Negative
-    values extract heat.
+    """Heat fed into a node set or through a surface: ``power`` [W] in total, shared in
+    proportion to ``area`` (equal shares when ``area`` is None), or ``flux`` [W/m^2] times
+    each node's ``area``. Negative values extract heat.
 
     ``area``: scalar (every node) or (n,) array over all nodes [m^2]; None = equal shares
-    (power) or :func:`exposed_area` (flux, needs a graph)."""
+    (power) or :func:`exposed_area` (flux, needs a graph). ``surface`` (instead of
+    ``nodes``): the elements with boundary faces on it, with their faces' areas."""
 
     name: str
-    nodes: Any
+    nodes: Any = None
     power: Optional[float] = None
     flux: Optional[float] = None
     area: Any = None
+    surface: Any = None
 
     def __post_init__(self):
         _check_bc(self, "heat-flux")
@@ -259,16 +288,21 @@ class HeatFlux:
 @dataclass(frozen=True)
 class Convection:
     """Convection ``h A_i (t_inf - T_i)`` [W] on a node set: ``h`` [W/(m^2 K)] >= 0, ``t_inf`` the
-    ambient temperature, ``area`` scalar or (n,) [m^2] (None = :func:`exposed_area`)."""
+    ambient temperature, ``area`` scalar or (n,) [m^2] (None = :func:`exposed_area`).
+    ``surface`` (instead of ``nodes``): on the boundary faces of that surface of the
+    container, in series with each element's half cell: ``sum_f A_f / (1/h + d_f/lambda)``."""
 
     name: str
-    nodes: Any
-    h: float
-    t_inf: float
+    nodes: Any = None
+    h: float = None
+    t_inf: float = None
     area: Any = None
+    surface: Any = None
 
     def __post_init__(self):
         _check_bc(self, "convection")
+        _required(self, "convection", "h", "W/(m^2 K)")
+        _required(self, "convection", "t_inf", "K")
         try:
             h = real_number(f"convection boundary condition {self.name!r}: h", self.h)
         except MaterialError as exc:
@@ -279,9 +313,35 @@ class Convection:
         object.__setattr__(self, "t_inf", _finite(f"convection boundary condition {self.name!r}: t_inf", self.t_inf))
 
 
+@dataclass(frozen=True)
+class HeatSource:
+    """A heat source inside the solid, on a node set (``nodes``; None = every element):
+    ``power`` [W] in total or ``density`` [W/m^3], shared in proportion to the elements'
+    volumes (the volumes the heat capacities stand for). Negative values are sinks."""
+
+    name: str
+    nodes: Any = None
+    power: Optional[float] = None
+    density: Optional[float] = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise BoundaryConditionError(f"heat source names must be non-empty strings, got {self.name!r}")
+        if self.nodes is not None:
+            check_selector(self.nodes, f"heat source {self.name!r}: nodes")
+        if (self.power is None) == (self.density is None):
+            raise BoundaryConditionError(f"heat source {self.name!r}: give exactly one of power= (W, total) or "
+                                         "density= (W/m^3)")
+        field_ = "power" if self.power is not None else "density"
+        object.__setattr__(self, field_, _finite(f"heat source {self.name!r}: {field_}", getattr(self, field_)))
+
+
 def resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
     """Node indices of a boundary condition's ``nodes`` (a selector with a graph, else node
     indices or a mask); BoundaryConditionError when it selects nothing."""
+    if getattr(bc, "surface", None) is not None:
+        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r} is a surface: resolve it through "
+                                     "ElectroThermalModel (which knows the container), or give nodes=")
     if graph is not None:
         return select_nodes(graph, bc.nodes, bc.name, "thermal boundary condition")
     if callable(bc.nodes):
@@ -411,6 +471,32 @@ class HeatStep:
         return abs(self.heat_change - inputs) / scale
 
 
+@dataclass(frozen=True, eq=False)
+class SteadyHeat:
+    """A steady temperature field (:meth:`HeatSolver.steady`); powers in W.
+
+    temperature : (n,) [K]
+    source_power, flux_power : the given sources and the imposed fluxes / heat sources on free nodes
+    convection_power : heat received from the ambient (negative: lost to it)
+    boundary_power : heat received from the fixed temperatures (negative: taken by them)
+    iterations, residual : of the linear solve (relative residual)
+    """
+
+    temperature: np.ndarray
+    source_power: float
+    flux_power: float
+    convection_power: float
+    boundary_power: float
+    iterations: int
+    residual: float
+
+    @property
+    def balance_error(self) -> float:
+        """|sum of the powers| / max |power|: zero at the exact steady state."""
+        terms = (self.source_power, self.flux_power, self.convection_power, self.boundary_power)
+        return abs(sum(terms)) / (max(abs(t) for t in terms) or 1.0)
+
+
 # ---------------------------------------------------------------------------------------
 # the integrator
 # ---------------------------------------------------------------------------------------
@@ -449,6 +535,14 @@ class HeatSolver:
         Default areas of Convection/HeatFlux(flux=) (else :func:`exposed_area` of ``graph``).
     nodes_of : dict name -> node indices, optional
         Already resolved node sets of the boundary conditions (used instead of their ``nodes``).
+    area_of : dict name -> areas [m^2] of the nodes of ``nodes_of[name]``, optional
+        Resolved areas of flux and convection conditions (surface conditions: their boundary
+        faces' areas; convection: the area in series with the half cells).
+    link_of : dict name -> conductances [W/K] of the nodes of ``nodes_of[name]``, optional
+        A fixed temperature held at a surface: each node exchanges ``G_i (T_s - T_i)`` with it
+        (the half-cell conductance); such a set is not eliminated, and its heat counts in
+        ``boundary`` like the eliminated sets'.
+    power : (n,) heat sources [W] held constant (HeatSource), optional; counted in ``flux``
     coords : (n, 3) node positions [m], optional (coarse space of 'cg-deflated')
 
     Notes
@@ -466,7 +560,8 @@ class HeatSolver:
                  flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), theta="backward-euler",
                  subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="cg",
                  time: float = 0.0, energy: Optional[dict] = None, graph: Optional[ContactGraph] = None, area=None,
-                 nodes_of: Optional[dict] = None, coords=None):
+                 nodes_of: Optional[dict] = None, area_of: Optional[dict] = None, link_of: Optional[dict] = None,
+                 power=None, coords=None):
         C = self._check_capacity(capacity)
         n = C.shape[0]
         if graph is not None and graph.n_nodes != n:
@@ -493,14 +588,30 @@ class HeatSolver:
         if len(set(names)) != len(names):
             raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
         nodes_of = dict(nodes_of or {})
+        area_of, link_of = dict(area_of or {}), dict(link_of or {})
 
         def nodes(bc):
             if bc.name in nodes_of:
-                return np.unique(np.asarray(nodes_of[bc.name], dtype=np.int64))
+                nd = np.asarray(nodes_of[bc.name], dtype=np.int64)
+                if bc.name in area_of or bc.name in link_of:
+                    return nd                   # aligned with its areas / conductances
+                return np.unique(nd)
             return resolve_nodes(bc, n, graph)
+
+        def per_node(table, bc, nd, what):
+            a = np.asarray(table[bc.name], dtype=float)
+            if a.shape != nd.shape or not np.all(np.isfinite(a)) or np.any(a < 0):
+                raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: {what} must be finite, >= 0 "
+                                             f"and one per node of the condition ({nd.size})")
+            return a
         owner = np.full(n, -1, dtype=np.int64)
         self._fixed_nodes = {}
+        self._links = {}
         for k, b in enumerate(self.fixed_bcs):
+            if b.name in link_of:
+                nd = nodes(b)
+                self._links[b.name] = (nd, per_node(link_of, b, nd, "link conductances (W/K)"))
+                continue
             nd = nodes(b)
             clash = nd[owner[nd] >= 0]
             if clash.size:
@@ -515,7 +626,15 @@ class HeatSolver:
         q = np.zeros(n)
         for b in self.flux_bcs:
             nd = nodes(b)
-            if b.power is not None:
+            if b.name in area_of:
+                a = per_node(area_of, b, nd, "areas (m^2)")
+                if b.power is not None:
+                    if a.sum() <= 0:
+                        raise BoundaryConditionError(f"heat-flux boundary condition {b.name!r}: the areas sum to 0")
+                    np.add.at(q, nd, b.power * a / a.sum())
+                else:
+                    np.add.at(q, nd, b.flux * a)
+            elif b.power is not None:
                 if b.area is None:
                     share = np.full(nd.size, 1.0 / nd.size)
                 else:
@@ -526,17 +645,30 @@ class HeatSolver:
                 np.add.at(q, nd, b.power * share)
             else:
                 np.add.at(q, nd, b.flux * resolve_area(b, nd, n, default_area))
+        if power is not None:
+            pw = np.asarray(power, dtype=float)
+            if pw.shape != (n,) or not np.all(np.isfinite(pw)):
+                raise BoundaryConditionError(f"power (heat sources) must be a finite ({n},) array (W per node)")
+            q += pw
         hA, hAT = np.zeros(n), np.zeros(n)
         for b in self.convection_bcs:
             nd = nodes(b)
-            ha = b.h * resolve_area(b, nd, n, default_area)
+            ha = b.h * (per_node(area_of, b, nd, "areas (m^2)") if b.name in area_of
+                        else resolve_area(b, nd, n, default_area))
             np.add.at(hA, nd, ha)
             np.add.at(hAT, nd, ha * b.t_inf)
         hA[self.fixed] = 0.0
         hAT[self.fixed] = 0.0
         q[self.fixed] = 0.0
-        self.flux_power, self.h_area, self._hAT = _ro(q), _ro(hA), hAT
-        self.nodes_of = {**self._fixed_nodes,
+        self._conv_hA, self._conv_hAT = hA, hAT
+        self.flux_power = _ro(q)
+        self._link_G = np.zeros(n)
+        for nd, g_link in self._links.values():
+            np.add.at(self._link_G, nd, g_link)
+        self._link_G[self.fixed] = 0.0
+        self.h_area = _ro(hA + self._link_G)
+        self._refresh_links()
+        self.nodes_of = {**self._fixed_nodes, **{k: v[0] for k, v in self._links.items()},
                          **{b.name: nodes(b) for b in self.flux_bcs + self.convection_bcs}}
 
         self._solver_spec = solver
@@ -579,7 +711,7 @@ class HeatSolver:
         return G
 
     def _build_structure(self):
-        groups = [self._fixed_nodes[b.name] for b in self.fixed_bcs]
+        groups = [self._fixed_nodes[b.name] for b in self.fixed_bcs if b.name in self._fixed_nodes]
         self.system = ReducedSystem(self.n, self.edges, groups)
         self._u = self.system.unknown_nodes
         self._d = np.flatnonzero(self.fixed)
@@ -649,8 +781,17 @@ class HeatSolver:
         for name, nodes in self._fixed_nodes.items():
             T[nodes] = self._fixed_value[name]
 
+    def _refresh_links(self):
+        """Right-hand side of the surface temperatures: sum G_i T_s on each node."""
+        GT = np.zeros(self.n)
+        for name, (nd, g_link) in self._links.items():
+            np.add.at(GT, nd, g_link * self._fixed_value[name])
+        GT[self.fixed] = 0.0
+        self._link_GT = GT
+        self._hAT = self._conv_hAT + GT
+
     def _fixed_group_values(self):
-        return np.array([self._fixed_value[b.name] for b in self.fixed_bcs], dtype=float)
+        return np.array([self._fixed_value[b.name] for b in self.fixed_bcs if b.name in self._fixed_nodes], dtype=float)
 
     @property
     def temperature(self) -> np.ndarray:
@@ -676,7 +817,10 @@ class HeatSolver:
         if name not in self._fixed_value:
             raise BoundaryConditionError(f"no fixed-temperature set named {name!r}; have {sorted(self._fixed_value)}")
         self._fixed_value[name] = _finite(f"fixed temperature {name!r}", temperature)
-        self._T[self._fixed_nodes[name]] = self._fixed_value[name]
+        if name in self._links:
+            self._refresh_links()
+        else:
+            self._T[self._fixed_nodes[name]] = self._fixed_value[name]
 
     @property
     def fixed_values(self) -> dict:
@@ -806,7 +950,8 @@ class HeatSolver:
         # energies (exact discrete balance of the theta scheme)
         Tth_u = Tu_theta_sum / n_sub
         boundary = dt * float(np.sum(self.system.group_flux(Tth_u, Tg))) if d.size else 0.0
-        convection = dt * float(np.sum(self._hAT[u] - self.h_area[u] * Tth_u))
+        boundary += dt * float(np.sum(self._link_GT[u] - self._link_G[u] * Tth_u))
+        convection = dt * float(np.sum(self._conv_hAT[u] - self._conv_hA[u] * Tth_u))
         step = HeatStep(time=self.time + dt, dt=dt, n_substeps=n_sub,
                         source_energy=dt * float(np.sum(src[u])), absorbed_energy=dt * float(np.sum(src[d])),
                         flux_energy=dt * float(np.sum(self.flux_power[u])), convection_energy=convection,
@@ -837,6 +982,83 @@ class HeatSolver:
         e["convection"] += step.convection_energy
         e["boundary"] += step.boundary_energy
         return step
+
+    # -- steady state ------------------------------------------------------------------------
+    def _check_sinks(self):
+        """Every connected part of the free nodes must reach a fixed temperature or a
+        convection: else its steady temperature is not defined."""
+        import scipy.sparse.csgraph as csg
+        u = self._u
+        if u.size == 0:
+            return
+        n_parts, label = csg.connected_components(self._Muu, directed=False)
+        sink = np.zeros(n_parts, bool)
+        np.logical_or.at(sink, label, self.h_area[u] > 0)
+        if self._Mud is not None and self._Mud.shape[1]:
+            touches = np.asarray(abs(self._Mud).sum(axis=1)).ravel() > 0
+            np.logical_or.at(sink, label, touches)
+        if not np.all(sink):
+            lost = int(np.sum(~sink[label]))
+            raise ThermalError(
+                f"{lost} element(s) in {int(np.sum(~sink))} connected part(s) reach no fixed temperature and no "
+                "convection: their steady temperature is not defined (any heat put in has nowhere to go). Add a "
+                "FixedTemperature or a Convection there, or integrate in time (advance)")
+
+    def steady(self, sources=None, apply: bool = True, rtol: float = 1e-12) -> SteadyHeat:
+        """The steady temperatures ``M T = s`` with the given ``sources`` [W per node] (plus the
+        fluxes, heat sources, convection and fixed temperatures of this solver); they replace
+        the current temperatures when ``apply`` (the clock does not move). Raises ThermalError
+        when some part of the network has no fixed temperature and no convection.
+
+        The linear solver is 'cg' (Jacobi) below 2,000 unknowns and 'cg-deflated' above it,
+        kept across calls, to ``rtol`` relative residual."""
+        n = self.n
+        src = np.zeros(n) if sources is None else np.asarray(sources, dtype=float)
+        if src.shape != (n,) or not np.all(np.isfinite(src)):
+            raise ThermalError(f"sources must be a finite ({n},) array (W per node)")
+        self._check_sinks()
+        u = self._u
+        Tg = self._fixed_group_values()
+        rhs = src[u] + self.flux_power[u] + self._hAT[u]
+        if Tg.size:
+            rhs = rhs - self._Mud @ Tg
+        T = self._T.copy()
+        info = {"iterations": 0, "residual": 0.0}
+        if u.size:
+            if getattr(self, "_steady_solver", None) is None or self._steady_key != id(self.system):
+                self._steady_solver = make_solver("auto", n_unknowns=u.size, rtol=rtol)
+                if self._coords is not None:
+                    e = self.edges
+                    d = self._coords[e[:, 1]] - self._coords[e[:, 0]]
+                    spacing = float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d)))) if e.size else None
+                    self._steady_solver.set_geometry(self._coords[u], spacing)
+                self._steady_key = id(self.system)
+                self._steady_A = None
+            if self._steady_A is None:
+                self._steady_A = self._Muu.copy()
+            else:
+                self._steady_A.data[:] = self._Muu.data
+                self._steady_solver.update(self._steady_A)
+            try:
+                Tu, info = self._steady_solver.solve(self._steady_A, rhs, x0=T[u])
+            except (SolverError, RuntimeError, ArithmeticError) as exc:
+                raise ThermalError(f"the steady heat solve failed ({exc}); the temperatures are unchanged") from exc
+            if not np.all(np.isfinite(Tu)):
+                raise ThermalError("the steady heat solve gave non-finite temperatures; the temperatures are "
+                                   "unchanged (check the sources and conductances)")
+            T[u] = Tu
+        Tu = T[u]
+        boundary = float(np.sum(self.system.group_flux(Tu, Tg))) if self._d.size else 0.0
+        boundary += float(np.sum(self._link_GT[u] - self._link_G[u] * Tu))
+        out = SteadyHeat(temperature=_ro(T), source_power=float(np.sum(src[u])),
+                         flux_power=float(np.sum(self.flux_power[u])),
+                         convection_power=float(np.sum(self._conv_hAT[u] - self._conv_hA[u] * Tu)),
+                         boundary_power=boundary, iterations=int(info.get("iterations", 0)),
+                         residual=float(info.get("residual", 0.0)))
+        if apply:
+            self._T = T
+            self._dT_prev = None
+        return out
 
     # -- construction from a graph ----------------------------------------------------------
     @classmethod

@@ -144,7 +144,6 @@ def random_inside(shape, rad, r0, rng, max_rounds=200):
 
 def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume):
     """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``)."""
-    n = rho.size
     phi_nom = float(np.sum(4 / 3 * np.pi * (rho * r0) ** 3)) / volume  # fraction at s = 1
     s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
     rel = Relaxer(shape, rho, r0, skin=skin)

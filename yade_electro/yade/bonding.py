@@ -47,6 +47,10 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     displacement (``CohFrictPhys.unp``) is set to its initial penetration (negative across
     a gap), so the bonded packing starts stress-free instead of pulling the gaps shut.
 
+    The packing's container (``packing.shape``) is kept in the scene (``O.tags``, saved with
+    it): the engines then know the solid without being told, use the ``voronoi`` law by
+    default and take surface boundary conditions (``container.face(...)``).
+
     Parameters
     ----------
     packing : SpherePacking
@@ -146,5 +150,13 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     else:
         O.engines = list(engines)
     del saved_engines
+    shape = getattr(packing, "shape", None)
+    if shape is not None:
+        from .persistence import add_container
+        try:
+            add_container(O, shape, ids)
+        except Exception as exc:        # a shape that cannot be pickled: the engines then need container=
+            log.warning("add_bonded_packing: the packing's container cannot be kept with the scene (%s); give "
+                        "container= to the engines", exc)
     return list(ids)
 

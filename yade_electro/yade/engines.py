@@ -42,12 +42,12 @@ from ..errors import BoundaryConditionError, ThermalError
 from ..geometry import Shape, as_shape
 from ..history import History
 from ..materials import real_number
-from ..thermal import Convection, FixedTemperature, HeatFlux
+from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource
 from . import persistence, registry
 from .runtime import import_yade
 from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute
 
-__all__ = ["ElectricalEngine", "ElectroThermalEngine", "ensure_thermal_state", "engine_class"]
+__all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ensure_thermal_state", "engine_class"]
 
 log = logging.getLogger(__name__)
 
@@ -186,12 +186,15 @@ class _Engine:
     # -- one call ------------------------------------------------------------------------------
     def step(self):
         """One call on the current scene (what the PyRunner calls)."""
+        return self._guarded(self._step)
+
+    def _guarded(self, fn):
         try:
             if self.removed:
                 raise RuntimeError(f"engine {self.label!r} was removed")
             if self.reader.scene_replaced:
                 self._reattach_in_place()
-            out = self._step()
+            out = fn()
         except Exception as exc:
             self.error = exc
             log.error("yade-electro engine %r failed at iteration %d: %s: %s", self.label, int(self.O.iter),
@@ -215,8 +218,17 @@ class ElectricalEngine(_Engine):
     ----------
     resistivity : float
         rho_e [ohm m].
-    electrodes : dict name -> dict(select=..., potential=V | current=A)
-    law, law_params, solver, measure, reselect : see ``yade_electro.electrical.ElectricalModel``
+    electrodes : dict name -> dict(select=... | surface=..., potential=V | current=A)
+        ``select``: an element layer (predicate, ids, mask; paper 000's electrodes).
+        ``surface``: a surface of the container (``container.face('top')``, a ``Plane``, a
+        region): the electrode acts at that surface, through each touching element's half cell.
+    law : str, optional
+        Conductance law; default ``'voronoi'`` when the container is known, else
+        ``'continuum'`` (paper 000's transmission-surface model).
+    container : Shape or YADE predicate, optional
+        The solid. Default: ``law_params['container']``, else the container of the packing
+        ``add_bonded_packing`` put in the scene.
+    law_params, solver, measure, reselect : see ``yade_electro.electrical.ElectricalModel``
         (a YADE predicate as ``law_params['container']`` is converted to a shape)
     iterPeriod : int >= 1
         Steps between two calls (the PyRunner's period).
@@ -237,49 +249,73 @@ class ElectricalEngine(_Engine):
 
     DEFAULT_LABEL = "electro"
 
-    def __init__(self, resistivity=None, electrodes=None, law="continuum", law_params=None, solver="auto",
+    def __init__(self, resistivity=None, electrodes=None, law=None, law_params=None, solver="auto",
                  measure=None, iterPeriod: int = 1, history: Optional[str] = None, history_mode: str = "w",
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, O=None, _resume=None):
+                 reselect: bool = False, container=None, O=None, _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
+        law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
         self._finish(history_mode)
+
+    def _law_and_container(self, law, law_params, container):
+        """The container (given, the law's, or the scene's packing's) and the law (default
+        'voronoi' with a container, else 'continuum')."""
+        law_params = dict(law_params or {})
+        if container is None:
+            container = law_params.get("container")
+        if container is None:
+            container = persistence.scene_container(self.O)
+        if container is not None and not isinstance(container, Shape):
+            container = as_shape(container)
+        self.container = container
+        if law is None:
+            law = "voronoi" if container is not None else "continuum"
+        if law == "voronoi" and container is not None:
+            law_params["container"] = law_params.get("container") or container
+        if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
+            law_params["container"] = as_shape(law_params["container"])
+        return law, law_params
 
     def _make_electrical(self, resistivity, electrodes, law, law_params, solver, measure, reselect):
         if resistivity is None:
             raise ValueError("give resistivity= (ohm m)")
         if electrodes is None or not isinstance(electrodes, dict) or not electrodes:
-            raise BoundaryConditionError("give electrodes={name: dict(select=..., potential=V | current=A)}")
-        law_params = dict(law_params or {})
-        if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
-            law_params["container"] = as_shape(law_params["container"])
+            raise BoundaryConditionError("give electrodes={name: dict(select=... or surface=..., potential=V | "
+                                         "current=A)}")
         self._law_params = law_params
         specs = []
         for name, spec in electrodes.items():
             if not isinstance(spec, dict):
-                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=..., potential=...|current=...)")
+                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=... or surface=..., "
+                                             "potential=...|current=...)")
             spec = dict(spec)
-            spec["select"] = self._normalise_selector(spec.get("select"))
-            unknown = set(spec) - {"select", "potential", "current"}
+            if spec.get("select") is not None:
+                spec["select"] = self._normalise_selector(spec["select"])
+            unknown = set(spec) - {"select", "surface", "potential", "current"}
             if unknown:
-                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}")
+                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select= or "
+                                             "surface=, and potential= (V) or current= (A)")
             specs.append(ElectrodeSpec(name, **spec))
         self._resistivity = resistivity
         return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
-                               reselect=reselect)
+                               reselect=reselect, container=self.container)
 
     # -- persistence ---------------------------------------------------------------------------
     def _electrode_config(self):
         out = {}
         for s in self.model.specs:
-            ids = self.model.memberships[s.name].ids
-            out[s.name] = dict(select=np.asarray(ids, dtype=np.int64), **(
-                {"potential": s.potential} if s.fixed else {"current": s.current}))
+            value = {"potential": s.potential} if s.fixed else {"current": s.current}
+            if s.surface is not None:
+                out[s.name] = dict(surface=self.model.surfaces[s.name].saved, **value)
+            else:
+                ids = self.model.memberships[s.name].ids
+                out[s.name] = dict(select=np.asarray(ids, dtype=np.int64), **value)
         return out
 
     def _law_config(self):
@@ -297,7 +333,7 @@ class ElectricalEngine(_Engine):
                     bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
                     move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                     bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
-                    plot=self.plot, reselect=o["reselect"])
+                    plot=self.plot, reselect=o["reselect"], container=self.container)
 
     def _save_state(self):
         persistence.save_state(self.O, self.label, {
@@ -340,6 +376,9 @@ class ElectricalEngine(_Engine):
 
     @property
     def solution(self):
+        """The last PotentialSolution of the network: its nodes are the elements (in
+        ``body_ids`` order), then one node per surface electrode (use :attr:`potential`
+        for the elements' values)."""
         return self.model.solution
 
     @property
@@ -414,8 +453,16 @@ class ElectroThermalEngine(ElectricalEngine):
     beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
     theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
     fixed, flux, convection : lists of ``yade_electro.thermal`` FixedTemperature, HeatFlux,
-        Convection; their ``nodes`` may be YADE predicates, body id lists or masks
+        Convection; their ``nodes`` may be YADE predicates, body id lists or masks, or give
+        ``surface=`` (a surface of the container, as for electrodes)
+    sources : list of ``yade_electro.thermal.HeatSource`` (heat generated inside the solid,
+        W or W/m^3, shared by element volume)
     thermal_dt : float, optional; time_scale : float
+    steady : bool
+        Each call solves the steady temperatures (with the Joule heat, sources and boundary
+        conditions of that moment; the thermal clock does not move) instead of a time step:
+        for a solid, or a bed, whose heat settles faster than it moves. :meth:`steady_state`
+        does the same once, from the script.
     thermal_solver : linear solver of the implicit heat step ('cg' default)
     coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
     """
@@ -424,16 +471,18 @@ class ElectroThermalEngine(ElectricalEngine):
 
     def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
                  temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(), flux=(), convection=(),
-                 thermal_dt=None, time_scale=1.0, thermal_solver="cg", coupled_options=None, law="continuum",
+                 sources=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
+                 coupled_options=None, law=None,
                  law_params=None, solver="auto", measure=None, iterPeriod: int = 1, history: Optional[str] = None,
                  history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
-                 label: Optional[str] = None, reselect: bool = False, O=None, _resume=None):
+                 label: Optional[str] = None, reselect: bool = False, container=None, O=None, _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
                     write_back if electrodes is not None else None, plot)
+        law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         if temperature is None:
             raise ValueError("give the initial temperature= (K)")
@@ -441,9 +490,7 @@ class ElectroThermalEngine(ElectricalEngine):
             self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
         else:
             self.model = None
-            self._law_params = dict(law_params or {})
-            if self._law_params.get("container") is not None and not isinstance(self._law_params["container"], Shape):
-                self._law_params["container"] = as_shape(self._law_params["container"])
+            self._law_params = law_params
             self._resistivity = resistivity
         if thermal_dt is not None:
             thermal_dt = real_number("thermal_dt (s)", thermal_dt)
@@ -459,19 +506,29 @@ class ElectroThermalEngine(ElectricalEngine):
             for bc in group:
                 if not isinstance(bc, cls):
                     raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.thermal), got {bc!r}")
-                out.append(dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
+                out.append(bc if bc.nodes is None else dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
             bcs.append(out)
+        heat_sources = []
+        for src in sources:
+            if not isinstance(src, HeatSource):
+                raise TypeError(f"expected HeatSource objects (yade_electro.thermal) in sources=, got {src!r}")
+            heat_sources.append(src if src.nodes is None else dataclasses.replace(
+                src, nodes=self._normalise_selector(src.nodes)))
+        if not isinstance(steady, bool):
+            raise ValueError(f"steady must be True or False, got {steady!r}")
+        self.steady = steady
         self._thermal = dict(density=density, specific_heat=specific_heat, conductivity=conductivity,
                              temperature=temperature, beta=beta, eta=eta, theta=theta, thermal_dt=thermal_dt,
-                             time_scale=time_scale, thermal_solver=thermal_solver,
+                             time_scale=time_scale, thermal_solver=thermal_solver, steady=steady,
                              coupled_options=dict(coupled_options or {}))
         extra = dict(coupled_options or {})
         if self.model is None:
             extra.setdefault("law", law)
             extra.setdefault("law_params", self._law_params)
+        extra.setdefault("container", self.container)
         self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
                                            eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
-                                           thermal_solver=thermal_solver, **extra)
+                                           sources=heat_sources, thermal_solver=thermal_solver, **extra)
         self._last_time = float(self.O.time)
         self._states_checked = -1
         if _resume is not None:
@@ -500,15 +557,21 @@ class ElectroThermalEngine(ElectricalEngine):
                       bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
                       move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                       bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=None, plot=self.plot,
-                      reselect=o["reselect"])
+                      reselect=o["reselect"], container=self.container)
         t = dict(self._thermal)
         bcs = {}
         for group in ("fixed", "flux", "convection"):
             out = []
             for bc in getattr(self.coupled, group):
-                ids = self.coupled.bc_memberships[bc.name].ids
-                out.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
+                if bc.surface is not None:
+                    out.append(dataclasses.replace(bc, surface=self.coupled.bc_surfaces[bc.name].saved))
+                else:
+                    ids = self.coupled.bc_memberships[bc.name].ids
+                    out.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
             bcs[group] = out
+        bcs["sources"] = [src if src.nodes is None else dataclasses.replace(
+            src, nodes=np.asarray(self.coupled.bc_memberships[src.name].ids, dtype=np.int64))
+            for src in self.coupled.heat_sources]
         kw.update(t)
         kw.update(bcs)
         return kw
@@ -540,13 +603,20 @@ class ElectroThermalEngine(ElectricalEngine):
         return super().written_attributes + ("state.temp",)
 
     # -- stepping ------------------------------------------------------------------------
-    def _step(self):
+    def steady_state(self) -> dict:
+        """Solve the steady temperatures now (from the script, e.g. before ``O.run``): reads the
+        scene, writes the temperatures (and potentials) back; returns the history row."""
+        return self._guarded(lambda: self._step(steady=True))
+
+    def _step(self, steady=None):
         graph = self.reader.read()
         if self.thermal_dt is not None:
             dt = self.thermal_dt
         else:
             dt = (float(self.O.time) - self._last_time) * self.time_scale
-        if dt <= 0:             # first call at the start of a run: nothing to integrate yet
+        if self.steady if steady is None else steady:
+            row = self.coupled.steady_state(graph)
+        elif dt <= 0:           # first call at the start of a run: nothing to integrate yet
             row = self.coupled.refresh(graph)
         else:
             row = self.coupled.step(graph, dt)
@@ -581,9 +651,26 @@ class ElectroThermalEngine(ElectricalEngine):
         return dict(zip(self.body_ids.tolist(), self.coupled.temperature.tolist()))
 
 
+class HeatEngine(ElectroThermalEngine):
+    """Heat conduction only (no electrodes): :class:`ElectroThermalEngine` with
+    ``electrodes=None``, the same boundary conditions (``fixed``, ``flux``, ``convection``,
+    ``sources``; nodes or surfaces), time steps or ``steady=True``. Its default label is
+    'heat'. (Not YADE's own ``ThermalEngine``, which needs a FlowEngine.)"""
+
+    DEFAULT_LABEL = "heat"
+
+    def __init__(self, density=None, specific_heat=None, conductivity=None, temperature=None, **kwargs):
+        if kwargs.get("electrodes") is not None:
+            raise ValueError("HeatEngine conducts heat only: use ElectroThermalEngine for electrodes")
+        kwargs["electrodes"] = None
+        super().__init__(density=density, specific_heat=specific_heat, conductivity=conductivity,
+                         temperature=temperature, **kwargs)
+
+
 def engine_class(name: str):
     """The engine class of a saved configuration."""
-    classes = {"ElectricalEngine": ElectricalEngine, "ElectroThermalEngine": ElectroThermalEngine}
+    classes = {"ElectricalEngine": ElectricalEngine, "ElectroThermalEngine": ElectroThermalEngine,
+               "HeatEngine": HeatEngine}
     try:
         return classes[name]
     except KeyError:

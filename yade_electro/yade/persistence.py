@@ -20,7 +20,7 @@ import pickle
 from typing import Optional
 
 __all__ = ["PREFIX", "config_key", "state_key", "save_config", "load_config", "save_state", "load_state",
-           "saved_labels", "forget"]
+           "saved_labels", "forget", "add_container", "scene_container"]
 
 PREFIX = "yade_electro"
 
@@ -88,3 +88,31 @@ def forget(O, label: str) -> None:
     for key in (config_key(label), state_key(label)):
         if key in tags.keys():
             tags[key] = ""
+
+
+CONTAINER_KEY = f"{PREFIX}:containers"
+
+
+def add_container(O, shape, ids) -> None:
+    """Record that the bodies ``ids`` were packed in ``shape`` (a Shape): what
+    ``add_bonded_packing`` leaves in the scene for the engines (saved with it)."""
+    tags = _tags(O)
+    kept = []
+    if CONTAINER_KEY in tags.keys() and tags[CONTAINER_KEY]:
+        kept = pickle.loads(base64.b64decode(tags[CONTAINER_KEY].encode("ascii")))
+    ids = list(int(i) for i in ids)
+    kept.append((shape, (min(ids), max(ids), len(ids)) if ids else (0, -1, 0)))
+    tags[CONTAINER_KEY] = base64.b64encode(pickle.dumps(kept, protocol=4)).decode("ascii")
+
+
+def scene_container(O):
+    """The container of the scene's packing when exactly one packing was added with one
+    (``add_bonded_packing``), else None."""
+    tags = _tags(O)
+    if CONTAINER_KEY not in tags.keys() or not tags[CONTAINER_KEY]:
+        return None
+    try:
+        kept = pickle.loads(base64.b64decode(tags[CONTAINER_KEY].encode("ascii")))
+    except Exception:           # a tag this version cannot read: as if there were none
+        return None
+    return kept[0][0] if len(kept) == 1 else None
