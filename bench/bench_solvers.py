@@ -28,7 +28,10 @@ import sys
 import time
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-HERE = os.path.dirname(os.path.abspath(__file__))
+# yade's launcher runs scripts with execfile(), where __file__ is the launcher's: use argv
+_SCRIPT = __file__ if __file__.endswith("bench_solvers.py") else (
+    sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_solvers.py") else __file__)
+HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 sys.path.insert(0, os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "cases"))
 
