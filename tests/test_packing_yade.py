@@ -198,6 +198,15 @@ YADE_SCRIPT = textwrap.dedent("""
     pos = np.array([O.bodies[i].state.pos for i in ids])
     out["max_disp"] = float(np.abs(pos - pk.centers).max() / pk.r_mean)
     out["n_bonds_after"] = sum(1 for i in O.interactions if i.isReal and not i.phys.cohesionBroken)
+    # the bonds are the cohesive law's: pulled apart, a bond across a gap pulls back (tension)
+    i0 = max(real, key=lambda i: -i.geom.penetrationDepth)
+    b2 = O.bodies[i0.id2]
+    b2.state.blockedDOFs = "xyzXYZ"
+    b2.state.vel = tuple(1e-3 * i0.geom.normal)
+    O.run(3, True)
+    out["gap"] = -i0.geom.penetrationDepth
+    out["tension"] = -i0.phys.normalForce.dot(i0.geom.normal)
+    out["tension_expected"] = i0.phys.kn * (i0.phys.unp - i0.geom.penetrationDepth)
     # JCFpm variant on a fresh scene
     O.reset()
     ids = P.add_bonded_packing(pk, material=JCFpmMat(young=210e9, poisson=0.3, density=7900, cohesion=5e8, tensileStrength=5e8, frictionAngle=0.4), detection_factor=k)
@@ -230,6 +239,8 @@ def test_add_bonded_packing_in_yade(tmp_path, rod, cache, yade_exe):
     assert out["dt_ok"]
     assert out["max_disp"] < 1e-6            # the bonded packing starts stress-free
     assert out["n_bonds_after"] == n_ref
+    assert out["gap"] > 0 and out["tension"] > 0
+    assert out["tension"] == pytest.approx(out["tension_expected"], rel=1e-6)
     assert out["jcfpm_bonds"] == n_ref and out["jcfpm_cohesive"]
     assert out["jcfpm_bonds_after"] == n_ref
 

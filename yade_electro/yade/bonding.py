@@ -41,11 +41,13 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     Every pair with ``|x_i - x_j| < detection_factor (r_i + r_j)`` (see :func:`bond_pairs`)
     is bonded by YADE: one step with an engine list whose ``Bo1_Sphere_Aabb.
     aabbEnlargeFactor`` and ``Ig2_Sphere_Sphere_ScGeom6D.interactionDetectionFactor``
-    equal ``detection_factor`` and whose Ip2 sets the cohesion now; no integrator runs
-    during that step, so nothing moves. The factors are then reset to 1 and cohesion is not
-    given to later contacts. With ``CohFrictMat``, each bond's reference normal
-    displacement (``CohFrictPhys.unp``) is set to its initial penetration (negative across
-    a gap), so the bonded packing starts stress-free instead of pulling the gaps shut.
+    equal ``detection_factor``, whose Ip2 sets the cohesion now and whose law is the
+    cohesive law the simulation will use; no integrator runs during that step, so nothing
+    moves. The factors are then reset to 1 and cohesion is not given to later contacts. With
+    ``CohFrictMat``, each bond's reference normal displacement (``CohFrictPhys.unp``) is set
+    to its initial penetration (negative across a gap), so the bonded packing starts
+    stress-free instead of pulling the gaps shut, and one more step with every sphere held
+    flushes the bonding step's forces (``O.iter`` advances by 2 in all).
 
     The packing's container (``packing.shape``) is kept in the scene (``O.tags``, saved with
     it): the engines then know the solid without being told, use the ``voronoi`` law by
@@ -112,18 +114,26 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
                            for c, r in zip(packing.centers.tolist(), packing.radii.tolist())])
     bo1 = W.Bo1_Sphere_Aabb(aabbEnlargeFactor=k)
     collider = W.InsertionSortCollider([bo1])
-    # the cohesive law must not run during the bonding step: it would break the bonds across
-    # gaps before their reference distance (unp) is set. A frictional law that never erases
-    # interactions stands in (it handles ScGeom6D/CohFrictPhys through their base classes).
-    # (JCFpm stores the initial distance itself, its own law is safe.)
-    stand_in = (W.Law2_ScGeom_FrictPhys_CundallStrack(neverErase=True) if kind == "CohFrictMat"
-                else law)
-    loop = W.InteractionLoop([ig2], [ip2], [stand_in])
+    # The cohesive law itself runs during the bonding step (YADE's InteractionLoop keeps the law
+    # functor it first used for an interaction: a stand-in law would stay in use for the bonds).
+    # With CohFrictMat it must not break the bonds across gaps before their reference distance
+    # (unp) is set: the material's strengths are made unlimited for that step, then each bond
+    # gets its real adhesions (YADE's own formula: strength * min(r1, r2)^2).
+    # (JCFpm stores the initial distance itself.)
+    strengths = None
+    if kind == "CohFrictMat":
+        strengths = (mat.normalCohesion, mat.shearCohesion)
+        mat.normalCohesion = mat.shearCohesion = 1e300
+    loop = W.InteractionLoop([ig2], [ip2], [law])
     saved_engines, saved_dt = O.engines, O.dt
     newton = W.NewtonIntegrator(damping=damping, dead=True)  # the collider wants one
     O.engines = [W.ForceResetter(), collider, loop, newton]
     O.dt = min(O.dt, utils.PWaveTimeStep()) if O.dt > 0 else utils.PWaveTimeStep()
-    O.step()
+    try:
+        O.step()
+    finally:
+        if strengths is not None:
+            mat.normalCohesion, mat.shearCohesion = strengths
     O.dt = saved_dt
     bo1.aabbEnlargeFactor = 1.0
     ig2.interactionDetectionFactor = 1.0
@@ -136,9 +146,29 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     for i in O.interactions:
         if i.id1 in ours and i.id2 in ours:
             if kind == "CohFrictMat":
-                i.phys.unp = i.geom.penetrationDepth
+                ph = i.phys
+                ph.unp = i.geom.penetrationDepth
+                ph.normalForce = (0, 0, 0)
+                ph.shearForce = (0, 0, 0)
+                r2 = min(O.bodies[i.id1].shape.radius, O.bodies[i.id2].shape.radius) ** 2
+                ph.normalAdhesion = strengths[0] * r2
+                ph.shearAdhesion = strengths[1] * r2
             n_bonds += 1
-    loop.lawDispatcher.functors = [law]
+    if kind == "CohFrictMat":
+        # the forces of the bonding step (unp still 0 then: every gap pulled) stay in YADE's force
+        # container until an integrator has consumed them; consume them in one step with every
+        # sphere held, so they never act
+        held = [(b, b.state.blockedDOFs) for b in (O.bodies[i] for i in ids)]
+        for b, _ in held:
+            b.state.blockedDOFs = "xyzXYZ"
+        newton.dead = False
+        O.dt = min(saved_dt, utils.PWaveTimeStep()) if saved_dt > 0 else utils.PWaveTimeStep()
+        O.step()
+        newton.dead = True
+        O.dt = saved_dt
+        for b, dofs in held:
+            b.state.blockedDOFs = dofs
+            b.state.vel = b.state.angVel = (0, 0, 0)
     log.info("add_bonded_packing: %d spheres, %d bonds (detection factor %.4g)", len(ids),
              n_bonds, k)
     if engines == "default":
