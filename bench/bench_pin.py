@@ -1,0 +1,89 @@
+"""What the electrical engine costs in the pin torsion case: the engine's share of the wall time
+with the engine every step and every 100 steps, each law, in the elastic range of the twist.
+
+The pin of ``cases/pin_torsion.py`` (kept calibration) is twisted at the paper's rate; blocks
+of ``--block`` steps alternate between the engine's PyRunner alive and dead, ``--blocks`` pairs,
+the order swapped every pair. YADE's own timing (``O.timingEnabled``, ``PyRunner.execTime``)
+gives the time inside the engine's calls.
+
+One JSON line per (law, period)::
+
+    {"bench": "pin", "n", "law", "period", "engine_share": time in the engine / wall of the
+     blocks with it, "ratio": wall with / wall without, "step_ms_without", "step_ms_with",
+     "moment_check_share": the moment-strength check's share (it runs in both), "load_average"}
+
+    yade-electro -n -x bench/bench_pin.py [--n 5000] [--block 400] [--blocks 3]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__ if __file__.endswith("bench_pin.py") else sys.argv[0]))
+for _p in (os.path.dirname(HERE), os.path.join(os.path.dirname(HERE), "cases")):
+    if _p not in sys.path:
+        sys.path.insert(0, _p)
+
+
+def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block=400, blocks=3):
+    import numpy as np
+    import pin_torsion as PT
+    from yade_electro.yade import ElectricalEngine
+    cal = PT.load_calibration(n, seed)
+    rate = PT.paper_rate()
+    pin = PT.build_pin(n, seed, cal["young"], cal["strength"], rate=rate, ramp_time=2 * PT.RAMP_ANGLE / rate)
+    O, cyl = pin["O"], pin["container"]
+    z, r, ids = pin["packing"].centers[:, 2], pin["packing"].radii, np.asarray(pin["ids"])
+    O.timingEnabled = True
+    out = []
+    for law in laws:
+        for period in periods:
+            if law == "voronoi":
+                el = {"top": dict(surface=cyl.face("top"), potential=1.0),
+                      "bottom": dict(surface=cyl.face("bottom"), potential=0.0)}
+            else:
+                rm = float(np.mean(r))
+                el = {"top": dict(select=ids[(PT.LENGTH - z - r) <= 0.1 * rm].tolist(), potential=1.0),
+                      "bottom": dict(select=ids[(z - r) <= 0.1 * rm].tolist(), potential=0.0)}
+            eng = ElectricalEngine(PT.RESISTIVITY, el, law=law, container=cyl, iterPeriod=period, bond_check="flags",
+                                   write_back=None, label=f"bench_{law}_{period}")
+            O.engines = O.engines + [eng.runner]
+            O.step()                                   # the first call builds everything: not timed
+            wall = {True: 0.0, False: 0.0}
+            steps = {True: 0, False: 0}
+            eng.runner.execTime = 0
+            check = pin["strength_check"].runner
+            check.execTime = 0
+            for k in range(blocks):
+                for alive in ((True, False) if k % 2 == 0 else (False, True)):
+                    eng.runner.dead = not alive
+                    t = time.perf_counter()
+                    O.run(block, True)
+                    wall[alive] += time.perf_counter() - t
+                    steps[alive] += block
+            row = {"bench": "pin", "n": len(ids), "law": law, "period": period,
+                   "engine_share": eng.runner.execTime * 1e-9 / wall[True], "ratio": wall[True] / wall[False],
+                   "step_ms_without": 1e3 * wall[False] / steps[False], "step_ms_with": 1e3 * wall[True] / steps[True],
+                   "moment_check_share": check.execTime * 1e-9 / (wall[True] + wall[False]),
+                   "theta_end": pin["rig"].theta, "broken": int(pin["strength_check"].broken),
+                   "load_average": os.getloadavg()[0]}
+            print(json.dumps(row), flush=True)
+            out.append(row)
+            eng.remove()
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=5000)
+    ap.add_argument("--block", type=int, default=400)
+    ap.add_argument("--blocks", type=int, default=3)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    return bench(args.n, block=args.block, blocks=args.blocks)
+
+
+if __name__ == "__main__":
+    main()

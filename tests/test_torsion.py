@@ -1,0 +1,108 @@
+"""Torsion closed forms, the reading of a twist test, and the VTK writer (numpy only)."""
+import math
+
+import numpy as np
+import pytest
+
+from yade_electro.torsion import (crack_summary, elastic_slope, elastic_torque, first_crossing, polar_moment,
+                                  ratio_at, surface_shear_stress, yield_angle)
+from yade_electro.vtk import write_bonds, write_elements
+
+
+def test_closed_forms_of_the_pin():
+    # paper 000 section 4: r = 1 mm, h = 5 mm, G = 48.062 GPa, tau_y = 400 MPa
+    assert polar_moment(1e-3) == pytest.approx(math.pi * 1e-12 / 2)
+    assert yield_angle(400e6, 48.062e9, 1e-3, 5e-3) == pytest.approx(0.041613, rel=1e-4)
+    # with d = 1 mm (r = 0.5 mm) it would be twice that, not the paper's 0.043
+    assert yield_angle(400e6, 48.062e9, 0.5e-3, 5e-3) == pytest.approx(0.083226, rel=1e-4)
+    T = elastic_torque(48.062e9, 1e-3, 5e-3, 0.041613)
+    assert surface_shear_stress(T, 1e-3) == pytest.approx(400e6, rel=1e-4)
+
+
+def test_elastic_slope_ignores_an_offset_and_the_range_outside():
+    th = np.linspace(0, 0.1, 101)
+    tq = 3.0 * th + 0.2
+    tq[th > 0.05] = 0.0                      # cracked: outside the fit range
+    assert elastic_slope(th, tq, theta_max=0.04, theta_min=0.01) == pytest.approx(3.0, rel=1e-12)
+    with pytest.raises(ValueError, match="fewer than 3 points"):
+        elastic_slope(th, tq, theta_max=0.0105, theta_min=0.01)
+
+
+def test_first_crossing_interpolates_and_counts_inf():
+    th = np.array([0.0, 0.1, 0.2, 0.3])
+    assert first_crossing(th, [1.0, 1.0, 1.2, 2.0], 1.1) == pytest.approx(0.15)
+    assert first_crossing(th, [1.0, 1.0, 1.05, np.inf], 1.1) == pytest.approx(0.3)
+    assert first_crossing(th, [1.0, 1.0, 1.0, 1.0], 1.1) is None
+
+
+def test_ratio_at_gives_inf_after_separation_and_nan_beyond_an_unseparated_test():
+    th = np.array([0.0, 0.02, 0.04, 0.06, 0.08])
+    r = np.array([1.0, 1.0, 1.5, np.inf, np.inf])
+    out = ratio_at(th, r, (0.03, 0.05, 0.07, 0.09))
+    assert out["0.03"] == pytest.approx(1.25)
+    assert out["0.05"] == pytest.approx(1.5)      # separated between the records: last finite value
+    assert out["0.07"] == math.inf
+    assert out["0.09"] == math.inf                # ended separated: still separated there
+    assert math.isnan(ratio_at(th, [1.0, 1.0, 1.1, 1.2, 1.3], (0.09,))["0.09"])   # ended whole
+
+
+def test_crack_summary():
+    th = np.array([0.0, 0.01, 0.02, 0.03, 0.04, 0.05])
+    r = np.array([1.0, 1.0, 1.005, 1.2, 2.5, np.inf])
+    nb = np.array([0, 0, 2, 30, 90, 200])
+    s = crack_summary(th, r, nb)
+    assert s["theta_first_break"] == 0.02
+    assert s["theta_R_rise"]["1%"] == pytest.approx(0.02 + 0.01 * (0.005 / 0.195))
+    assert s["theta_R_rise"]["100%"] == pytest.approx(0.03 + 0.01 * (0.8 / 1.3))
+    assert s["theta_separation"] == 0.05
+    assert s["broken_at_separation"] == 200
+    never = crack_summary(th, np.ones(6), np.zeros(6))
+    assert never["theta_first_break"] is None and never["theta_separation"] is None
+    with pytest.raises(ValueError, match="one shape"):
+        crack_summary(th, r[:3], nb)
+
+
+def _read_vtk(path):
+    lines = open(path).read().split("\n")
+    assert lines[0].startswith("# vtk DataFile Version 3.0") and lines[2] == "ASCII"
+    out = {}
+    k = 0
+    while k < len(lines):
+        words = lines[k].split()
+        if words[:1] == ["POINTS"]:
+            n = int(words[1])
+            out["points"] = np.array([[float(x) for x in lines[k + 1 + i].split()] for i in range(n)])
+            k += n
+        elif words[:1] in (["LINES"], ["VERTICES"]):
+            n = int(words[1])
+            out[words[0]] = np.array([[int(x) for x in lines[k + 1 + i].split()] for i in range(n)])
+            k += n
+        elif words[:1] == ["SCALARS"]:
+            name = words[1]
+            vals = []
+            k += 2
+            while k < len(lines) and lines[k] and not lines[k].split()[0].isalpha():
+                vals.append(float(lines[k]))
+                k += 1
+            out[name] = np.array(vals)
+            continue
+        k += 1
+    return out
+
+
+def test_vtk_files_round_trip(tmp_path):
+    x = np.array([[0, 0, 0], [1e-3, 0, 0], [0, 2e-3, 0]], float)
+    p = write_elements(str(tmp_path / "e.vtk"), x, [1e-4, 2e-4, 3e-4], {"potential": [0.0, 0.5, np.nan]})
+    d = _read_vtk(p)
+    assert np.allclose(d["points"], x)
+    assert np.allclose(d["radius"], [1e-4, 2e-4, 3e-4])
+    assert np.allclose(d["potential"], [0.0, 0.5, 0.0])          # nan written as 0
+    assert d["VERTICES"].tolist() == [[1, 0], [1, 1], [1, 2]]
+    q = write_bonds(str(tmp_path / "b.vtk"), x, [[0, 1], [1, 2]], {"broken": [0, 1]})
+    d = _read_vtk(q)
+    assert d["LINES"].tolist() == [[2, 0, 1], [2, 1, 2]]
+    assert d["broken"].tolist() == [0.0, 1.0]
+    with pytest.raises(ValueError, match="shape"):
+        write_elements(str(tmp_path / "x.vtk"), x, [1, 2, 3], {"potential": [1.0]})
+    with pytest.raises(ValueError, match="bond indices"):
+        write_bonds(str(tmp_path / "y.vtk"), x, [[0, 3]])
