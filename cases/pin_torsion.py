@@ -61,8 +61,8 @@ Outputs (``--out``, default out/pin_torsion)
 -------------------------------------------
 ``pin_n<N>_s<seed>.csv`` (one row per record: theta, torque, tau/tau_y, energies, broken
 bonds, R and R/R0 per law), ``.png`` (paper figure 16: torque and tau/tau_y, R/R0, broken
-bonds against theta), VTK snapshots ``vtk/pin_<stage>_elements.vtk`` (potential of each law,
-displacement, broken bonds per element) and ``_bonds.vtk`` (every initial bond, ``broken`` = 1
+bonds against theta), VTK snapshots (meshio) ``vtk/pin_<stage>_elements.vtu`` (potential of each law,
+displacement, broken bonds per element) and ``_bonds.vtu`` (every initial bond, ``broken`` = 1
 once broken) at the stages ``before`` (last record before the first break), ``onset`` (first
 record with R/R0 >= 1.01) and ``separation`` (last record before R = inf, or the last record).
 Ends with one JSON line (``case``, ``law``, ``n``, ``elastic_torque_error_pct``,
@@ -277,10 +277,10 @@ class _Snapshots:
         fields = {f"potential_{k}": v for k, v in s["potentials"].items()}
         disp = s["pos"] - self.ref_pos
         fields.update(displacement=np.linalg.norm(disp, axis=1), broken_bonds=nb)
-        e = write_elements(os.path.join(self.dir, f"pin_{stage}_elements.vtk"), s["pos"], self.reader.graph.radius,
-                           fields, title=f"pin torsion {stage}, theta {s['theta']:.5f} rad")
-        b = write_bonds(os.path.join(self.dir, f"pin_{stage}_bonds.vtk"), s["pos"], self.pairs,
-                        {"broken": s["broken"].astype(float)}, title=f"pin bonds {stage}")
+        e = write_elements(os.path.join(self.dir, f"pin_{stage}_elements.vtu"), s["pos"], self.reader.graph.radius,
+                           fields)
+        b = write_bonds(os.path.join(self.dir, f"pin_{stage}_bonds.vtu"), s["pos"], self.pairs,
+                        {"broken": s["broken"].astype(float)})
         self.written[stage] = {"theta": s["theta"], "elements": e, "bonds": b}
 
 

@@ -62,47 +62,20 @@ def test_crack_summary():
         crack_summary(th, r[:3], nb)
 
 
-def _read_vtk(path):
-    lines = open(path).read().split("\n")
-    assert lines[0].startswith("# vtk DataFile Version 3.0") and lines[2] == "ASCII"
-    out = {}
-    k = 0
-    while k < len(lines):
-        words = lines[k].split()
-        if words[:1] == ["POINTS"]:
-            n = int(words[1])
-            out["points"] = np.array([[float(x) for x in lines[k + 1 + i].split()] for i in range(n)])
-            k += n
-        elif words[:1] in (["LINES"], ["VERTICES"]):
-            n = int(words[1])
-            out[words[0]] = np.array([[int(x) for x in lines[k + 1 + i].split()] for i in range(n)])
-            k += n
-        elif words[:1] == ["SCALARS"]:
-            name = words[1]
-            vals = []
-            k += 2
-            while k < len(lines) and lines[k] and not lines[k].split()[0].isalpha():
-                vals.append(float(lines[k]))
-                k += 1
-            out[name] = np.array(vals)
-            continue
-        k += 1
-    return out
-
-
 def test_vtk_files_round_trip(tmp_path):
+    import meshio
     x = np.array([[0, 0, 0], [1e-3, 0, 0], [0, 2e-3, 0]], float)
-    p = write_elements(str(tmp_path / "e.vtk"), x, [1e-4, 2e-4, 3e-4], {"potential": [0.0, 0.5, np.nan]})
-    d = _read_vtk(p)
-    assert np.allclose(d["points"], x)
-    assert np.allclose(d["radius"], [1e-4, 2e-4, 3e-4])
-    assert np.allclose(d["potential"], [0.0, 0.5, 0.0])          # nan written as 0
-    assert d["VERTICES"].tolist() == [[1, 0], [1, 1], [1, 2]]
-    q = write_bonds(str(tmp_path / "b.vtk"), x, [[0, 1], [1, 2]], {"broken": [0, 1]})
-    d = _read_vtk(q)
-    assert d["LINES"].tolist() == [[2, 0, 1], [2, 1, 2]]
-    assert d["broken"].tolist() == [0.0, 1.0]
+    p = write_elements(str(tmp_path / "e.vtu"), x, [1e-4, 2e-4, 3e-4], {"potential": [0.0, 0.5, np.nan]})
+    m = meshio.read(p)
+    assert np.allclose(m.points, x)
+    assert np.allclose(m.point_data["radius"], [1e-4, 2e-4, 3e-4])
+    assert np.allclose(m.point_data["potential"], [0.0, 0.5, 0.0])          # nan written as 0
+    assert m.cells[0].type == "vertex" and m.cells[0].data.ravel().tolist() == [0, 1, 2]
+    q = write_bonds(str(tmp_path / "b.vtu"), x, [[0, 1], [1, 2]], {"broken": [0, 1]})
+    m = meshio.read(q)
+    assert m.cells[0].type == "line" and m.cells[0].data.tolist() == [[0, 1], [1, 2]]
+    assert m.cell_data["broken"][0].tolist() == [0.0, 1.0]
     with pytest.raises(ValueError, match="shape"):
-        write_elements(str(tmp_path / "x.vtk"), x, [1, 2, 3], {"potential": [1.0]})
+        write_elements(str(tmp_path / "x.vtu"), x, [1, 2, 3], {"potential": [1.0]})
     with pytest.raises(ValueError, match="bond indices"):
-        write_bonds(str(tmp_path / "y.vtk"), x, [[0, 3]])
+        write_bonds(str(tmp_path / "y.vtu"), x, [[0, 3]])
