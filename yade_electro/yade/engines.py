@@ -449,7 +449,11 @@ class ElectroThermalEngine(ElectricalEngine):
     mask, geometry_every, move_tolerance, full_read_every, bond_check, plot, label : see ElectricalEngine
         ``electrodes=None``: heat conduction only (no resistivity needed).
     density [kg/m^3], specific_heat [J/(kg K)], conductivity [W/(m K)] : thermal material
-    temperature : initial temperature [K]
+    temperature : initial temperature [K] (of every element, and of elements added later)
+    initial_temperature : dict body id -> K, optional
+        Starting temperatures of chosen elements (the others start at ``temperature``), e.g. a
+        hot and a cold half of a bed. Ignored when the engine resumes a saved run (the
+        temperatures are then the bodies' ``b.state.temp``).
     beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
     theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
     fixed, flux, convection : lists of ``yade_electro.thermal`` FixedTemperature, HeatFlux,
@@ -470,7 +474,8 @@ class ElectroThermalEngine(ElectricalEngine):
     DEFAULT_LABEL = "electrothermal"
 
     def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
-                 temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(), flux=(), convection=(),
+                 temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(),
+                 flux=(), convection=(),
                  sources=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
                  coupled_options=None, law=None,
                  law_params=None, solver="auto", measure=None, iterPeriod: int = 1, history: Optional[str] = None,
@@ -531,12 +536,27 @@ class ElectroThermalEngine(ElectricalEngine):
                                            sources=heat_sources, thermal_solver=thermal_solver, **extra)
         self._last_time = float(self.O.time)
         self._states_checked = -1
+        if initial_temperature is not None and _resume is None:
+            self.coupled.restore_temperatures(self._initial_temperatures(initial_temperature, temperature))
         if _resume is not None:
             st = self._resume_state
             self._last_time = float(st.get("mech_time", self._last_time))
             self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
             self.coupled.restore_temperatures(self._read_temperatures)
         self._finish(history_mode)
+
+    def _initial_temperatures(self, table, default):
+        """A function graph -> starting temperatures from ``{body id: K}`` (checked now)."""
+        if not hasattr(table, "items"):
+            raise ValueError(f"initial_temperature must be a dict body id -> temperature (K), got {type(table).__name__}")
+        known = {b.id for b in self.O.bodies if b is not None}
+        values = {}
+        for k, v in table.items():
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or int(k) not in known:
+                raise ValueError(f"initial_temperature: {k!r} is not the id of a body of this scene")
+            values[int(k)] = real_number(f"initial_temperature[{k}] (K)", v)
+        t0 = float(default)
+        return lambda graph: np.array([values.get(int(i), t0) for i in graph.ids], dtype=float)
 
     def _read_temperatures(self, graph):
         yade = import_yade()
