@@ -197,9 +197,7 @@ def calibrate(n=5000, seed=1, twist_steps=3000, hold_chunk=500, max_hold=12, cac
         O.step()
     rig.rotation.angularVelocity = (theta_y - rig.theta) / O.dt       # land on theta_y exactly
     O.step()
-    rig.rate, rig.ramp_time = 0.0, 0.0
-    rig.rotation.angularVelocity = 0.0
-    rig.advance = lambda: None                                        # hold still
+    rig.hold()
     probe["newton"].damping = 0.8
     last = None
     for k in range(max_hold):

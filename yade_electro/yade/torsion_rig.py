@@ -86,6 +86,8 @@ class TorsionRig:
         yade = import_yade()
         from yade import wrapper as W
         self.O = O if O is not None else yade.Omega()
+        if not (isinstance(label, str) and label.isidentifier()) or label in _RIGS:
+            raise ValueError(f"rig label must be a new Python identifier, got {label!r} (taken: {sorted(_RIGS)})")
         if not rate > 0:
             raise ValueError(f"twist rate must be > 0 rad/s, got {rate}")
         if not ramp_time >= 0:
@@ -111,8 +113,6 @@ class TorsionRig:
             b.state.blockedDOFs = "xyzXYZ"
             b.state.vel = (0, 0, 0)
             b.state.angVel = (0, 0, 0)
-        if not (isinstance(label, str) and label.isidentifier()) or label in _RIGS:
-            raise ValueError(f"rig label must be a new Python identifier, got {label!r} (taken: {sorted(_RIGS)})")
         self.label = label
         self.rotation = W.RotationEngine(ids=self.top_ids, rotationAxis=tuple(self.axis), rotateAroundZero=True,
                                          zeroPoint=tuple(self.origin), angularVelocity=0.0,
@@ -138,6 +138,11 @@ class TorsionRig:
     def free_length(self) -> float:
         """Distance [m] between the grips' mean axial positions: the twisted length."""
         return self.grip_axial[1] - self.grip_axial[0]
+
+    def hold(self):
+        """Stop turning: the top grip stays where it is from the next step on."""
+        self.rate, self.ramp_time = 0.0, 0.0
+        self.rotation.angularVelocity = 0.0
 
     def angular_velocity(self, t: float) -> float:
         """The prescribed twist rate [rad/s] at time t [s]."""
