@@ -155,13 +155,29 @@ class ContinuumLaw(ConductanceLaw):
         return s / edge_lengths(graph, edges)
 
 
-def contact_radius(graph: ContactGraph, edges=None) -> np.ndarray:
+#: contact-radius models of the contact laws
+CONTACT_RADII = ("geometric", "hertz")
+
+
+def contact_radius(graph: ContactGraph, edges=None, model: str = "geometric") -> np.ndarray:
     """Radius a [m] of the contact circle of each edge's two overlapping spheres (0 where
-    they do not overlap): a^2 = r1^2 - ((r1^2 - r2^2 + d^2) / (2 d))^2."""
+    they do not overlap).
+
+    ``model='geometric'``: the circle where the two spheres' surfaces cross (the lens of the
+    overlap), a^2 = r1^2 - ((r1^2 - r2^2 + d^2) / (2 d))^2, about sqrt(2 R* delta) for small
+    overlaps. ``model='hertz'``: the Hertz contact radius a = sqrt(R* delta), R* = r1 r2 /
+    (r1 + r2), delta = r1 + r2 - d; for a Hertz contact under a force F (YADE's
+    Hertz-Mindlin law), a = (3 F R* / (4 E*))^(1/3).
+    """
+    if model not in CONTACT_RADII:
+        raise ValueError(f"contact radius model must be one of {CONTACT_RADII}, got {model!r}")
     edges = graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     r1 = graph.radius[edges[:, 0]]
     r2 = graph.radius[edges[:, 1]]
     d = edge_lengths(graph, edges)
+    if model == "hertz":
+        delta = np.clip(r1 + r2 - d, 0.0, None)
+        return np.sqrt(r1 * r2 / (r1 + r2) * delta)
     x = (r1 ** 2 - r2 ** 2 + d ** 2) / (2.0 * d)
     a2 = r1 ** 2 - x ** 2
     a2 = np.where(d < r1 + r2, a2, 0.0)
@@ -170,22 +186,35 @@ def contact_radius(graph: ContactGraph, edges=None) -> np.ndarray:
 
 @register_conductance_law("contact")
 class ContactLaw(ConductanceLaw):
-    """Constriction of overlapping spheres (papers 002, 003): g = 2 a."""
+    """Constriction of overlapping spheres (papers 002, 003): g = 2 a (heat: H = 2 k a;
+    current: 2 a / rho_e). ``radius``: 'geometric' (lens of the overlap) or 'hertz' (see
+    :func:`contact_radius`)."""
 
     name = "contact"
 
+    def __init__(self, radius: str = "geometric"):
+        if radius not in CONTACT_RADII:
+            raise ValueError(f"radius must be one of {CONTACT_RADII}, got {radius!r}")
+        self.radius = radius
+
     def factor(self, graph, edges=None):
-        return 2.0 * contact_radius(graph, self._edges(graph, edges))
+        return 2.0 * contact_radius(graph, self._edges(graph, edges), self.radius)
 
 
 @register_conductance_law("liggghts")
 class LiggghtsLaw(ConductanceLaw):
-    """LIGGGHTS' form 4 k1 k2 / (k1 + k2) sqrt(pi a^2) = k_edge 2 sqrt(pi) a: g = 2 sqrt(pi) a."""
+    """LIGGGHTS' form 4 k1 k2 / (k1 + k2) sqrt(pi a^2) = k_edge 2 sqrt(pi) a: g = 2 sqrt(pi) a;
+    ``radius`` as for the contact law."""
 
     name = "liggghts"
 
+    def __init__(self, radius: str = "geometric"):
+        if radius not in CONTACT_RADII:
+            raise ValueError(f"radius must be one of {CONTACT_RADII}, got {radius!r}")
+        self.radius = radius
+
     def factor(self, graph, edges=None):
-        return 2.0 * np.sqrt(np.pi) * contact_radius(graph, self._edges(graph, edges))
+        return 2.0 * np.sqrt(np.pi) * contact_radius(graph, self._edges(graph, edges), self.radius)
 
 
 @register_conductance_law("voronoi")
