@@ -29,27 +29,19 @@ for _p in (os.path.dirname(HERE), os.path.join(os.path.dirname(HERE), "cases")):
 
 
 def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block=400, blocks=3):
-    import numpy as np
     import pin_torsion as PT
     from yade_electro.yade import ElectricalEngine
     cal = PT.load_calibration(n, seed)
     rate = PT.paper_rate()
     pin = PT.build_pin(n, seed, cal["young"], cal["strength"], rate=rate, ramp_time=2 * PT.RAMP_ANGLE / rate)
     O, cyl = pin["O"], pin["container"]
-    z, r, ids = pin["packing"].centers[:, 2], pin["packing"].radii, np.asarray(pin["ids"])
     O.timingEnabled = True
     out = []
     for law in laws:
         for period in periods:
-            if law == "voronoi":
-                el = {"top": dict(surface=cyl.face("top"), potential=1.0),
-                      "bottom": dict(surface=cyl.face("bottom"), potential=0.0)}
-            else:
-                rm = float(np.mean(r))
-                el = {"top": dict(select=ids[(PT.LENGTH - z - r) <= 0.1 * rm].tolist(), potential=1.0),
-                      "bottom": dict(select=ids[(z - r) <= 0.1 * rm].tolist(), potential=0.0)}
-            eng = ElectricalEngine(PT.RESISTIVITY, el, law=law, container=cyl, iterPeriod=period, bond_check="flags",
-                                   write_back=None, label=f"bench_{law}_{period}")
+            el, params = PT.pin_electrodes(pin, law)
+            eng = ElectricalEngine(PT.RESISTIVITY, el, law=law, law_params=params, container=cyl, iterPeriod=period,
+                                   bond_check="flags", write_back=None, label=f"bench_{law}_{period}")
             O.engines = O.engines + [eng.runner]
             O.step()                                   # the first call builds everything: not timed
             wall = {True: 0.0, False: 0.0}
@@ -64,7 +56,7 @@ def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block
                     O.run(block, True)
                     wall[alive] += time.perf_counter() - t
                     steps[alive] += block
-            row = {"bench": "pin", "n": len(ids), "law": law, "period": period,
+            row = {"bench": "pin", "n": len(pin["ids"]), "law": law, "period": period,
                    "engine_share": eng.runner.execTime * 1e-9 / wall[True], "ratio": wall[True] / wall[False],
                    "step_ms_without": 1e3 * wall[False] / steps[False], "step_ms_with": 1e3 * wall[True] / steps[True],
                    "moment_check_share": check.execTime * 1e-9 / (wall[True] + wall[False]),

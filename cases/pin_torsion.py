@@ -163,6 +163,22 @@ def build_pin(n, seed, young, strength, rate, ramp_time, check_every=STRENGTH_EV
                 newton=e[3], r_mean=r_mean, strength_check=strength_check)
 
 
+def pin_electrodes(pin, law):
+    """(electrodes, law_params) of each law's engine on the pin built by :func:`build_pin`:
+    ``voronoi``: the end faces as surface electrodes, crack rule ``facets``; ``continuum``: the
+    end element layers z - r <= 0.1 r_mean (paper 000). 1 V on top, 0 V at the bottom."""
+    cyl = pin["container"]
+    if law == "voronoi":
+        return ({"top": dict(surface=cyl.face("top"), potential=1.0),
+                 "bottom": dict(surface=cyl.face("bottom"), potential=0.0)}, dict(container=cyl, crack="facets"))
+    if law == "continuum":
+        ids, z, r = np.asarray(pin["ids"]), pin["packing"].centers[:, 2], pin["packing"].radii
+        gap = 0.1 * pin["r_mean"]
+        return ({"top": dict(select=ids[(LENGTH - z - r) <= gap].tolist(), potential=1.0),
+                 "bottom": dict(select=ids[(z - r) <= gap].tolist(), potential=0.0)}, None)
+    raise ValueError(f"law must be one of {LAWS}, got {law!r}")
+
+
 def bond_loads(O, grip):
     """(q, mode): for each bond not touching a grip, its load per unit strength [Pa]: the
     largest of the tension -F_n / r^2, the shear (|F_s| - F_n tan phi) / r^2 (F_n > 0 in
@@ -230,16 +246,22 @@ def calibrate(n=5000, seed=1, twist_steps=3000, hold_chunk=500, max_hold=12, cac
     return out
 
 
+def _kept_calibrations(path=CALIBRATION_FILE) -> dict:
+    """The calibrations kept in ``path``, by "n<N>_s<seed>" ({} when there is no file)."""
+    if not os.path.exists(path):
+        return {}
+    with open(path) as fh:
+        return json.load(fh)
+
+
 def load_calibration(n, seed, out_dir=None, path=CALIBRATION_FILE, cache_dir=None, progress=print):
     """The calibration for (n, seed): the one kept in ``path`` (``--calibrate`` writes there), else
     ``<out_dir>/calibration_n<N>_s<seed>.json``, else a new one, written to that file (each
     batch job its own file: parallel jobs never write one file)."""
     key = f"n{n}_s{seed}"
-    if os.path.exists(path):
-        with open(path) as fh:
-            kept = json.load(fh)
-        if key in kept:
-            return kept[key]
+    kept = _kept_calibrations(path)
+    if key in kept:
+        return kept[key]
     own = os.path.join(out_dir or ".", f"calibration_{key}.json")
     if os.path.exists(own):
         with open(own) as fh:
@@ -291,25 +313,14 @@ def run_pin(n=5000, seed=1, laws=LAWS, rate_factor=1.0, every=100, theta_max=0.1
     rate = paper_rate() * rate_factor
     pin = build_pin(n, seed, cal["young"], cal["strength"], rate=rate, ramp_time=2 * RAMP_ANGLE / rate,
                     cache_dir=cache_dir)
-    O, rig, cyl, r_mean = pin["O"], pin["rig"], pin["container"], pin["r_mean"]
+    O, rig, cyl = pin["O"], pin["rig"], pin["container"]
     h = rig.free_length
     theta_y = yield_angle(SHEAR_YIELD, SHEAR_MODULUS, RADIUS, h)
     os.makedirs(out_dir, exist_ok=True)
     tag = f"pin_n{n}_s{seed}" + ("" if rate_factor == 1 else f"_rate{rate_factor:g}")
     engines = {}
-    z, r = pin["packing"].centers[:, 2], pin["packing"].radii
     for law in laws:
-        if law == "voronoi":
-            electrodes = {"top": dict(surface=cyl.face("top"), potential=1.0),
-                          "bottom": dict(surface=cyl.face("bottom"), potential=0.0)}
-            params = dict(container=cyl, crack="facets")
-        elif law == "continuum":
-            ids = np.asarray(pin["ids"])
-            electrodes = {"top": dict(select=ids[(LENGTH - z - r) <= 0.1 * r_mean].tolist(), potential=1.0),
-                          "bottom": dict(select=ids[(z - r) <= 0.1 * r_mean].tolist(), potential=0.0)}
-            params = None
-        else:
-            raise ValueError(f"law must be one of {LAWS}, got {law!r}")
+        electrodes, params = pin_electrodes(pin, law)
         engines[law] = ElectricalEngine(RESISTIVITY, electrodes, law=law, law_params=params, container=cyl,
                                         iterPeriod=every, bond_check="flags", write_back=None,
                                         label=f"pin_{law}", history=os.path.join(out_dir, f"{tag}_{law}.csv"))
@@ -326,7 +337,6 @@ def run_pin(n=5000, seed=1, laws=LAWS, rate_factor=1.0, every=100, theta_max=0.1
         key = np.sort(g.ids[g.edges], axis=1) @ np.array([1, 1 << 32])
         if "keys" not in state:
             state["keys"], state["pairs"] = key, np.searchsorted(g.ids, np.sort(g.ids[g.edges], axis=1))
-            state["ids"] = g.ids
             if vtk:
                 state["snap"] = _Snapshots(out_dir, state["pairs"], first.reader, first.reader.positions())
         broken = ~np.isin(state["keys"], key)
@@ -478,10 +488,7 @@ def main(argv=None):
     args = apply_batch_table(args, columns=("n", "seed", "law", "rate_factor", "every"))
     if args.calibrate:
         cal = calibrate(args.n, args.seed)
-        kept = {}
-        if os.path.exists(CALIBRATION_FILE):
-            with open(CALIBRATION_FILE) as fh:
-                kept = json.load(fh)
+        kept = _kept_calibrations()
         kept[f"n{args.n}_s{args.seed}"] = cal
         with open(CALIBRATION_FILE, "w") as fh:
             json.dump(kept, fh, indent=1)

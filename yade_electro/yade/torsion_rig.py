@@ -8,17 +8,17 @@ rotate exactly, not along the tangent). The twist angle follows ``theta(t)``: an
 ``rate * min(1, t / ramp_time)`` (a linear start, so the loading sends no step wave), the
 angle the integral of it, accumulated step by step as the rotation engine applies it.
 
-Reading, each ``record_every`` steps (``TorsionRig.record``): the angle [rad], the torques
-[N m] that the bar exerts on each grip about the axis (``utils.sumTorques`` over the grip's
-ids: C++, ~0.1 ms), the kinetic energy of the scene and the elastic energy of the bonds
-(``Law2_ScGeom6D_CohFrictPhys_CohesionMoment.elasticEnergy``, when that law runs) [J].
+Reading, when asked (``TorsionRig.record``, e.g. from a ``TorsionRig.recorder``): the angle
+[rad], the torques [N m] that the bar exerts on each grip about the axis
+(``utils.sumTorques`` over the grip's ids: C++, ~0.1 ms), the kinetic energy of the scene and
+the elastic energy of the bonds (``Law2_ScGeom6D_CohFrictPhys_CohesionMoment.elasticEnergy``,
+when that law runs) [J].
 
 Units: SI (m, s, rad, N m, J).
 """
 from __future__ import annotations
 
-import dataclasses
-from typing import List, Optional
+from typing import Optional
 
 import numpy as np
 
@@ -40,18 +40,6 @@ def grip_layers(axial, length: float, depth: float):
     if np.any(bottom & top):
         raise ValueError(f"grip depth {depth:g} m makes the grips overlap in a bar of length {length:g} m")
     return bottom, top
-
-
-@dataclasses.dataclass
-class TorsionRecord:
-    """The rig's record: one entry per ``record`` call."""
-    iter: List[int] = dataclasses.field(default_factory=list)
-    time: List[float] = dataclasses.field(default_factory=list)
-    theta: List[float] = dataclasses.field(default_factory=list)
-    torque_top: List[float] = dataclasses.field(default_factory=list)
-    torque_bottom: List[float] = dataclasses.field(default_factory=list)
-    kinetic: List[float] = dataclasses.field(default_factory=list)
-    elastic: List[float] = dataclasses.field(default_factory=list)
 
 
 class TorsionRig:
@@ -106,7 +94,6 @@ class TorsionRig:
         self.grip_depth = float(grip_depth)
         self.rate, self.ramp_time = float(rate), float(ramp_time)
         self.theta = 0.0
-        self.record_ = TorsionRecord()
         self._callbacks, self._runners = [], []
         for i in self.bottom_ids + self.top_ids:
             b = self.O.bodies[i]
@@ -164,17 +151,13 @@ class TorsionRig:
         return u.sumTorques(self.top_ids, ax, pt), u.sumTorques(self.bottom_ids, ax, pt)
 
     def record(self) -> dict:
-        """Append one record (angle, torques, energies) and return it."""
+        """One record (angle, torques, energies) of this step, as a dict."""
         O = self.O
         t_top, t_bot = self.torques()
         kin = float(self._utils.kineticEnergy())
         el = float(sum(f.elasticEnergy() for f in self._laws)) if self._laws else float("nan")
-        rec = self.record_
-        row = dict(iter=int(O.iter), time=float(O.time), theta=float(self.theta), torque_top=float(t_top),
-                   torque_bottom=float(t_bot), kinetic=kin, elastic=el)
-        for k, v in row.items():
-            getattr(rec, k).append(v)
-        return row
+        return dict(iter=int(O.iter), time=float(O.time), theta=float(self.theta), torque_top=float(t_top),
+                    torque_bottom=float(t_bot), kinetic=kin, elastic=el)
 
     def recorder(self, callback, iterPeriod: int):
         """A PyRunner that calls ``callback()`` every ``iterPeriod`` steps (put it after the
