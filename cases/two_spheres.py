@@ -64,19 +64,26 @@ def contact_circle_radius(r1=RADIUS, r2=RADIUS, d=DISTANCE) -> float:
     return math.sqrt(r1 ** 2 - x ** 2)
 
 
-def closed_form(t, law):
-    """(T_1, T_2) [K] at times t [s] for the law."""
-    C = DENSITY * SPECIFIC_HEAT * 4.0 / 3.0 * math.pi * RADIUS ** 3
-    H = CONDUCTIVITY * FACTOR[law](contact_circle_radius())
-    t = np.asarray(t, float)
-    mean, half = 0.5 * (T_HOT + T_COLD), 0.5 * (T_HOT - T_COLD) * np.exp(-2.0 * H / C * t)
-    return mean + half, mean - half
+def sphere_capacity() -> float:
+    """C = rho c (4/3) pi r^3 [J/K] of one sphere."""
+    return DENSITY * SPECIFIC_HEAT * 4.0 / 3.0 * math.pi * RADIUS ** 3
+
+
+def contact_conductance(law) -> float:
+    """H = k g [W/K] of the contact for the law."""
+    return CONDUCTIVITY * FACTOR[law](contact_circle_radius())
 
 
 def decay_time(law) -> float:
     """tau = C / (2 H) [s], the decay time of the temperature difference."""
-    C = DENSITY * SPECIFIC_HEAT * 4.0 / 3.0 * math.pi * RADIUS ** 3
-    return C / (2.0 * CONDUCTIVITY * FACTOR[law](contact_circle_radius()))
+    return sphere_capacity() / (2.0 * contact_conductance(law))
+
+
+def closed_form(t, law):
+    """(T_1, T_2) [K] at times t [s] for the law: the difference decays as exp(-t / tau)."""
+    t = np.asarray(t, float)
+    mean, half = 0.5 * (T_HOT + T_COLD), 0.5 * (T_HOT - T_COLD) * np.exp(-t / decay_time(law))
+    return mean + half, mean - half
 
 
 def run_law(law, steps_per_tau=200, taus=5.0, theta="crank-nicolson"):
@@ -119,7 +126,7 @@ def run_law(law, steps_per_tau=200, taus=5.0, theta="crank-nicolson"):
     mean_drift = float(np.max(np.abs(0.5 * (T1 + T2) - 0.5 * (T_HOT + T_COLD))))
     g = engine.coupled.network.factor if hasattr(engine.coupled.network, "factor") else None
     out = {"law": law, "max_error_pct": float(err), "tau_s": tau, "thermal_dt_s": dt, "steps": n,
-           "contact_radius_m": contact_circle_radius(), "H_W_per_K": CONDUCTIVITY * FACTOR[law](contact_circle_radius()),
+           "contact_radius_m": contact_circle_radius(), "H_W_per_K": contact_conductance(law),
            "engine_factor_m": (float(np.asarray(g)[0]) if g is not None and np.size(g) else None),
            "mean_drift_K": mean_drift, "T_final": [float(T1[-1]), float(T2[-1])]}
     engine.remove()
