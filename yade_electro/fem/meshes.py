@@ -127,6 +127,29 @@ class _GmshSession:
         return False
 
 
+def _background_field(gmsh, field):
+    """Make ``field`` the mesh size everywhere (points and boundaries do not override it)."""
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+
+
+def _refined_near_curves(gmsh, curves, size_min, size_max, dist_min, dist_max):
+    """Mesh size size_min within dist_min of ``curves``, growing linearly to size_max at
+    dist_max (gmsh Distance + Threshold fields), as the background field."""
+    f = gmsh.model.mesh.field
+    dist = f.add("Distance")
+    f.setNumbers(dist, "CurvesList", list(curves))
+    f.setNumber(dist, "NumPointsPerCurve", 200)
+    thr = f.add("Threshold")
+    f.setNumber(thr, "InField", dist)
+    f.setNumber(thr, "SizeMin", size_min)
+    f.setNumber(thr, "SizeMax", size_max)
+    f.setNumber(thr, "DistMin", dist_min)
+    f.setNumber(thr, "DistMax", dist_max)
+    _background_field(gmsh, thr)
+
+
 def _extruded_tets(gmsh, surfaces, thickness, h, size_field=None, layers=None):
     """Extrude 2D ``surfaces`` by ``thickness`` along z in layers (default ceil(t / h))
     and mesh; return (p, t)."""
@@ -305,19 +328,7 @@ def plate_mesh(geometry: PlateGeometry = PlateGeometry(), h: float = 1e-3,
     h_src = min(h, source_refinement * h)
 
     def sizes(gmsh):
-        f = gmsh.model.mesh.field
-        dist = f.add("Distance")
-        f.setNumbers(dist, "CurvesList", hole_curves)
-        f.setNumber(dist, "NumPointsPerCurve", 200)
-        thr = f.add("Threshold")
-        f.setNumber(thr, "InField", dist)
-        f.setNumber(thr, "SizeMin", h_src)
-        f.setNumber(thr, "SizeMax", h)
-        f.setNumber(thr, "DistMin", 0.0)
-        f.setNumber(thr, "DistMax", 2.0 * r)
-        f.setAsBackgroundMesh(thr)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        _refined_near_curves(gmsh, hole_curves, h_src, h, 0.0, 2.0 * r)
 
     with _GmshSession() as gmsh:
         occ = gmsh.model.occ
@@ -475,9 +486,7 @@ def notched_bar_mesh(geometry: NotchedBarGeometry = NotchedBarGeometry(), h: flo
         f.setNumber(box, "ZMin", -1.0)
         f.setNumber(box, "ZMax", g.thickness + 1.0)
         f.setNumber(box, "Thickness", g.notch_width)
-        f.setAsBackgroundMesh(box)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        _background_field(gmsh, box)
 
     with _GmshSession() as gmsh:
         occ = gmsh.model.occ
@@ -546,19 +555,7 @@ def cracked_bar_mesh(geometry: CrackedBarGeometry = CrackedBarGeometry(), h: flo
     h_f = front_refinement * h
 
     def sizes(gmsh):
-        f = gmsh.model.mesh.field
-        dist = f.add("Distance")
-        f.setNumbers(dist, "CurvesList", [front])
-        f.setNumber(dist, "NumPointsPerCurve", 200)
-        thr = f.add("Threshold")
-        f.setNumber(thr, "InField", dist)
-        f.setNumber(thr, "SizeMin", h_f)
-        f.setNumber(thr, "SizeMax", h)
-        f.setNumber(thr, "DistMin", 2 * h_f)
-        f.setNumber(thr, "DistMax", 2 * h)
-        f.setAsBackgroundMesh(thr)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        _refined_near_curves(gmsh, [front], h_f, h, 2 * h_f, 2 * h)
 
     with _GmshSession() as gmsh:
         occ = gmsh.model.occ
