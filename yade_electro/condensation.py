@@ -126,7 +126,8 @@ class ReducedSystem:
         edge_of = np.concatenate([e_dd, e_dd, e_dd, e_dd, eid[ud_i], eid[ud_j]])
         sign = np.concatenate([-np.ones(2 * ndd), np.ones(2 * ndd + int(ud_i.sum()) + int(ud_j.sum()))])
         self._dd_map = _map(slot[:edge_of.size], edge_of, sign, self.Kdd.nnz, m)
-        self.Kdu = None
+        self._Kdu = None
+        self._assembled = False
 
     # -- values ------------------------------------------------------------------------------
     def assemble(self, values, diagonal=None):
@@ -134,13 +135,22 @@ class ReducedSystem:
         optional extra diagonal (nu,) on the unknowns (e.g. ``h A`` or ``C / dt``). Returns
         ``(Kuu, Kud)``."""
         c = np.asarray(values, dtype=float)
+        self._assembled = True
         self.Kuu.data[:] = self._uu_map @ c
         if diagonal is not None:
             self.Kuu.data[self.diagonal_slots] += diagonal
         self.Kud.data[:] = self._ud_map @ c
         self.Kdd.data[:] = self._dd_map @ c
-        self.Kdu = self.Kud.T.tocsr()
+        self._Kdu = None
         return self.Kuu, self.Kud
+
+    @property
+    def Kdu(self):
+        """``K_ud`` transposed (CSR, ng x nu), made when first asked for after an assembly;
+        None before the first."""
+        if self._Kdu is None and self.Kud.data.size + self.Kud.shape[1] and self._assembled:
+            self._Kdu = self.Kud.T.tocsr()
+        return self._Kdu
 
     def unknown_diagonal(self) -> np.ndarray:
         """The diagonal of ``Kuu`` (nu,) as last assembled."""

@@ -137,6 +137,11 @@ class ConductanceLaw:
     def _edges(self, graph, edges):
         return graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
 
+    def wall_factor(self, radius, overlap) -> np.ndarray:
+        """g [m] of sphere-wall contacts; only the contact laws have them."""
+        raise ValueError(f"law {self.name!r} has no sphere-wall contacts: walls conduct in the granular mode, with a "
+                         "contact law (law='contact' or 'liggghts', bonds='contacts')")
+
 
 @register_conductance_law("continuum")
 class ContinuumLaw(ConductanceLaw):
@@ -184,37 +189,75 @@ def contact_radius(graph: ContactGraph, edges=None, model: str = "geometric") ->
     return np.sqrt(np.clip(a2, 0.0, None))
 
 
-@register_conductance_law("contact")
-class ContactLaw(ConductanceLaw):
-    """Constriction of overlapping spheres (papers 002, 003): g = 2 a (heat: H = 2 k a;
-    current: 2 a / rho_e). ``radius``: 'geometric' (lens of the overlap) or 'hertz' (see
-    :func:`contact_radius`)."""
+#: exponents of the softened-stiffness correction a_real = a_sim s^k, s = E*_sim / E*_real
+STIFFNESS_CORRECTIONS = {"hertz": 1.0 / 3.0, "hooke": 0.5, "lethe": 0.2}
 
-    name = "contact"
 
-    def __init__(self, radius: str = "geometric"):
+class GranularLaw(ConductanceLaw):
+    """Base of the contact laws: a contact radius model, an optional softened-stiffness
+    correction, and sphere-wall contacts.
+
+    A DEM run often softens the particles (Young's modulus E*_sim below the real E*_real) to
+    afford a longer time step; the overlaps, hence the contact radii, are then too large.
+    ``stiffness_ratio`` s = E*_sim / E*_real (0 < s <= 1) scales the radius by s^k:
+
+    * ``correction='hertz'`` (default), k = 1/3: at a given force a Hertz contact radius goes
+      as E*^(-1/3); the area as s^(2/3), LIGGGHTS' ``area_correction`` for Hertz;
+    * ``'hooke'``, k = 1/2: a linear spring's overlap goes as 1/k_n, the area as s
+      (LIGGGHTS' exponent 1 for Hooke);
+    * ``'lethe'``, k = 1/5: the radius correction Lethe uses (after Morris et al. 2016,
+      which matches the heat of colliding, not resting, particles).
+    """
+
+    def __init__(self, radius: str = "geometric", stiffness_ratio: float = 1.0, correction: str = "hertz"):
         if radius not in CONTACT_RADII:
             raise ValueError(f"radius must be one of {CONTACT_RADII}, got {radius!r}")
-        self.radius = radius
+        try:
+            s = float(stiffness_ratio)
+        except (TypeError, ValueError):
+            raise ValueError(f"stiffness_ratio must be a number in (0, 1] (E*_sim / E*_real), got "
+                             f"{stiffness_ratio!r}") from None
+        if not (0.0 < s <= 1.0):
+            raise ValueError(f"stiffness_ratio must be in (0, 1] (E*_sim / E*_real: the simulated stiffness over "
+                             f"the real one), got {stiffness_ratio!r}")
+        if correction not in STIFFNESS_CORRECTIONS:
+            raise ValueError(f"correction must be one of {sorted(STIFFNESS_CORRECTIONS)}, got {correction!r}")
+        self.radius, self.stiffness_ratio, self.correction = radius, s, correction
+        self._scale = s ** STIFFNESS_CORRECTIONS[correction]
+
+    #: g per unit contact radius [-]
+    SHAPE = 2.0
+
+    def contact_radius(self, graph, edges=None) -> np.ndarray:
+        """Corrected contact radius a [m] of each edge."""
+        return self._scale * contact_radius(graph, self._edges(graph, edges), self.radius)
 
     def factor(self, graph, edges=None):
-        return 2.0 * contact_radius(graph, self._edges(graph, edges), self.radius)
+        return self.SHAPE * self.contact_radius(graph, edges)
+
+    def wall_factor(self, radius, overlap) -> np.ndarray:
+        """g [m] of spheres of ``radius`` pressed by ``overlap`` into a wall (a plane)."""
+        from .contacts import plane_contact_radius
+        return self.SHAPE * self._scale * plane_contact_radius(radius, overlap, self.radius)
+
+
+@register_conductance_law("contact")
+class ContactLaw(GranularLaw):
+    """Constriction of overlapping spheres (papers 002, 003): g = 2 a (heat: H = 2 k a;
+    current: 2 a / rho_e). ``radius``: 'geometric' (lens of the overlap) or 'hertz' (see
+    :func:`contact_radius`); ``stiffness_ratio``, ``correction``: see :class:`GranularLaw`."""
+
+    name = "contact"
+    SHAPE = 2.0
 
 
 @register_conductance_law("liggghts")
-class LiggghtsLaw(ConductanceLaw):
+class LiggghtsLaw(GranularLaw):
     """LIGGGHTS' form 4 k1 k2 / (k1 + k2) sqrt(pi a^2) = k_edge 2 sqrt(pi) a: g = 2 sqrt(pi) a;
-    ``radius`` as for the contact law."""
+    ``radius`` and the stiffness correction as for the contact law."""
 
     name = "liggghts"
-
-    def __init__(self, radius: str = "geometric"):
-        if radius not in CONTACT_RADII:
-            raise ValueError(f"radius must be one of {CONTACT_RADII}, got {radius!r}")
-        self.radius = radius
-
-    def factor(self, graph, edges=None):
-        return 2.0 * np.sqrt(np.pi) * contact_radius(graph, self._edges(graph, edges), self.radius)
+    SHAPE = 2.0 * np.sqrt(np.pi)
 
 
 @register_conductance_law("voronoi")

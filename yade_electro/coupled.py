@@ -43,8 +43,8 @@ from .history import History
 from .materials import Material, edge_conductivity, real_number
 from .selection import Membership
 from .boundary import BoundaryOfGraph, SurfaceMembership
-from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, HeatSource, diffusion_time_step,
-                      heat_capacity, theta_of)
+from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, HeatSource, ThermalWall,
+                      diffusion_time_step, heat_capacity, theta_of)
 
 __all__ = ["ElectroThermalModel"]
 
@@ -95,6 +95,10 @@ class ElectroThermalModel:
     law, law_params : conductance law of the heat-only model (``electrical=None``).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
+    walls : sequence of ThermalWall, optional
+        Walls of a granular bed (isothermal or adiabatic); their contacts are given before
+        each step by :meth:`set_wall_contacts` (the YADE engine does it from the scene).
+        Needs a contact law ('contact', 'liggghts').
     """
 
     def __init__(self, electrical: Optional[ElectricalModel], density, specific_heat, conductivity,
@@ -104,7 +108,7 @@ class ElectroThermalModel:
                  flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), area=None,
                  volume_fraction=None, cell_volume=None, coupling_iterations: int = 0, coupling_tol: float = 1e-10,
                  resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None,
-                 sources: Sequence[HeatSource] = (), container=None):
+                 sources: Sequence[HeatSource] = (), container=None, walls: Sequence[ThermalWall] = ()):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.electrical) or None")
         self.electrical = electrical
@@ -137,6 +141,11 @@ class ElectroThermalModel:
             if not isinstance(src, HeatSource):
                 raise TypeError(f"expected HeatSource objects, got {src!r}")
         names += [src.name for src in self.heat_sources]
+        self.walls = list(walls)
+        for w in self.walls:
+            if not isinstance(w, ThermalWall):
+                raise TypeError(f"expected ThermalWall objects (yade_electro.thermal) in walls=, got {w!r}")
+        names += [w.name for w in self.walls]
         if len(set(names)) != len(names):
             from .errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition and heat source names must be unique, got {names}")
@@ -149,6 +158,15 @@ class ElectroThermalModel:
                             for b in everything if b.surface is not None}
         self.network = electrical.network if electrical is not None else FactorNetwork(
             make_law(law, **dict(law_params or {})))
+        if self.walls:
+            law_ = self.network.law
+            try:
+                law_.wall_factor(np.ones(1), np.zeros(1))
+            except ValueError as exc:
+                from .errors import BoundaryConditionError
+                raise BoundaryConditionError(f"walls= given with law {law_.name!r}: {exc}") from None
+        self._wall_contacts = {w.name: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
+        self._walls_applied = None
         if container is None and electrical is not None:
             container = electrical.container
         if container is None:
@@ -189,12 +207,24 @@ class ElectroThermalModel:
             return 0.0 if self._energy0 is None else self._energy0.get("source", 0.0) + self._energy0.get("absorbed", 0.0)
         return self.heat.energy["source"] + self.heat.energy["absorbed"]
 
+    @property
+    def energy_ledger(self) -> dict:
+        """The heat solver's energy ledger [J] plus each wall's heat (``link:<name>``): what
+        :meth:`restore` takes back."""
+        if self.heat is None:
+            return dict(self._energy0 or {})
+        out = dict(self.heat.energy)
+        out.update({f"link:{k}": v for k, v in self.heat.link_energy.items()})
+        return out
+
     def restore(self, time: float, energy: Optional[dict] = None):
         """Continue a saved run: thermal clock [s] and energy ledger [J] (before the first step)."""
         if self.heat is not None:
             self.heat.time = float(time)
             if energy:
                 self.heat.energy.update({k: float(v) for k, v in energy.items() if k in self.heat.energy})
+                for k in self.heat.link_energy:
+                    self.heat.link_energy[k] = float(energy.get(f"link:{k}", self.heat.link_energy[k]))
         else:
             self._time0, self._energy0 = float(time), dict(energy or {})
 
@@ -218,7 +248,11 @@ class ElectroThermalModel:
         if self.heat is None or graph.n_nodes != self.heat.n or kind == "structure" and not np.array_equal(
                 graph.ids, self._ids):
             self._new_heat_solver(graph)
+            self._apply_walls(graph)
             return
+        walls_changed = self._apply_walls(graph, assemble=False)
+        if walls_changed and kind not in ("structure", "topology", "geometry"):
+            self.heat.update_values()
         if kind == "structure":
             self.heat.update_edges(self.network.edges, self._thermal_conductance(graph), self._capacities(graph))
             self.n_rebuilds += 1
@@ -227,6 +261,45 @@ class ElectroThermalModel:
                                    None if self.cell_volume is not None else self._capacities(graph))
         elif kind == "geometry":
             self.heat.update_values(self._thermal_conductance(graph))
+
+    # -- walls -------------------------------------------------------------------------------
+    def set_wall_contacts(self, name: str, nodes, overlap):
+        """The spheres touching wall ``name`` now (node indices of the next step's graph) and
+        their overlaps [m] (> 0); applied at the next step."""
+        if name not in self._wall_contacts:
+            from .errors import BoundaryConditionError
+            raise BoundaryConditionError(f"no wall named {name!r}; have {sorted(self._wall_contacts)}")
+        nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
+        dl = np.asarray(overlap, dtype=float).reshape(-1)
+        if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
+            raise ValueError(f"wall {name!r}: overlaps must be finite, >= 0 and one per node")
+        self._wall_contacts[name] = (nd, dl)
+        self._walls_applied = None
+
+    def wall_conductances(self, graph: ContactGraph) -> dict:
+        """name -> (nodes, G [W/K]) of each wall's contacts on ``graph`` (adiabatic walls too:
+        what they would conduct)."""
+        lam = np.asarray(self.material.conductivity, dtype=float)
+        out = {}
+        for w in self.walls:
+            nd, dl = self._wall_contacts[w.name]
+            if nd.size and nd.max() >= graph.n_nodes:
+                raise ValueError(f"wall {w.name!r}: contact node index beyond the graph's {graph.n_nodes} nodes")
+            lam_p = lam if lam.ndim == 0 else lam[nd]
+            lam_w = lam_p if w.conductivity is None else w.conductivity
+            lam_e = 2.0 * lam_p * lam_w / (lam_p + lam_w)
+            out[w.name] = (nd, lam_e * self.network.law.wall_factor(graph.radius[nd], dl))
+        return out
+
+    def _apply_walls(self, graph, assemble=True) -> bool:
+        """Give the heat solver the walls' contacts; True if they were new."""
+        if not self.walls or self._walls_applied is graph:
+            return False
+        for name, (nd, G) in self.wall_conductances(graph).items():
+            if name in self.heat.nodes_of:              # isothermal: a linked fixed temperature
+                self.heat.set_links(name, nd, G, assemble=assemble)
+        self._walls_applied = graph
+        return True
 
     def _new_heat_solver(self, graph):
         T = np.full(graph.n_nodes, self.initial_temperature)
@@ -237,7 +310,7 @@ class ElectroThermalModel:
             pos = np.clip(np.searchsorted(old_ids[order], graph.ids), 0, old_ids.size - 1)
             found = old_ids[order][pos] == graph.ids
             T[found] = old_T[order][pos[found]]
-            time, energy = self.heat.time, dict(self.heat.energy)
+            time, energy = self.heat.time, self.energy_ledger
         elif self._T_restore is not None:
             T = self._T_restore(graph)
         nodes_of = {name: m.nodes(graph) for name, m in self.bc_memberships.items()}
@@ -254,10 +327,16 @@ class ElectroThermalModel:
                 area_of[b.name] = contact.convection_area(b.h, lam)
             else:
                 area_of[b.name] = contact.area
+        fixed = list(self.fixed)
+        for w in self.walls:
+            if w.isothermal:
+                fixed.append(FixedTemperature(w.name, nodes=np.zeros(0, dtype=np.int64), temperature=w.temperature))
+                nodes_of[w.name], link_of[w.name] = np.zeros(0, dtype=np.int64), np.zeros(0)
         capacity = self._capacities(graph)
         area = self.area(graph) if callable(self.area) else self.area
+        self._walls_applied = None
         self.heat = HeatSolver(capacity, self.network.edges, self._thermal_conductance(graph), T,
-                               fixed=self.fixed, flux=self.flux, convection=self.convection, time=time,
+                               fixed=fixed, flux=self.flux, convection=self.convection, time=time,
                                energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
                                link_of=link_of, power=self._source_power(graph), coords=graph.pos,
                                **self.heat_options)
@@ -462,4 +541,13 @@ class ElectroThermalModel:
             "n_substeps": step.n_substeps if step is not None else 0,
             "n_potential_solves": self.n_potential_solves,
         })
+        if self.walls:
+            flows = heat.link_flows()
+            for w in self.walls:
+                if not w.isothermal:
+                    continue                # adiabatic: nothing to report
+                nd, _ = self._wall_contacts[w.name]
+                row[f"wall_contacts:{w.name}"] = int(nd.size)
+                row[f"wall_power:{w.name}"] = flows.get(w.name, 0.0)
+                row[f"wall_heat:{w.name}"] = heat.link_energy.get(w.name, 0.0)
         return row

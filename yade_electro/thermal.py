@@ -62,7 +62,7 @@ from .surfaces import eccentricity, volume_fraction as _volume_fraction
 __all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
            "resolve_nodes", "resolve_area",
            "exposed_area", "stable_time_step", "diffusion_time_step", "theta_of",
-           "FixedTemperature", "HeatFlux", "Convection", "HeatSource", "ThermalState", "HeatStep", "HeatSolver",
+           "FixedTemperature", "ThermalWall", "HeatFlux", "Convection", "HeatSource", "ThermalState", "HeatStep", "HeatSolver",
            "SteadyHeat"]
 
 log = logging.getLogger(__name__)
@@ -256,6 +256,38 @@ class FixedTemperature:
         _required(self, "fixed-temperature", "temperature", "K")
         object.__setattr__(self, "temperature",
                            _finite(f"fixed-temperature boundary condition {self.name!r}: temperature", self.temperature))
+
+
+@dataclass(frozen=True)
+class ThermalWall:
+    """A wall of a granular bed (a YADE ``Wall``, ``Box`` or facet mesh) for the heat model.
+
+    ``temperature`` [K]: the wall is isothermal at that value and every sphere touching it
+    exchanges ``G (T_wall - T_i)`` through the contact (G from the contact law with the
+    sphere-plane contact radius, :func:`yade_electro.contacts.plane_contact_radius`); None:
+    adiabatic (its contacts carry no heat). ``conductivity`` [W/(m K)]: the wall's material
+    (default the particles'); a contact takes the harmonic mean of the two, as a contact
+    between two particles of different materials does. The heat a wall gives goes into the
+    history (``wall_heat:<name>``, cumulative J) and into ``boundary_heat``."""
+
+    name: str
+    temperature: Optional[float] = None
+    conductivity: Optional[float] = None
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise BoundaryConditionError(f"wall names must be non-empty strings, got {self.name!r}")
+        if self.temperature is not None:
+            object.__setattr__(self, "temperature", _finite(f"wall {self.name!r}: temperature", self.temperature))
+        if self.conductivity is not None:
+            lam = _finite(f"wall {self.name!r}: conductivity", self.conductivity)
+            if not lam > 0:
+                raise BoundaryConditionError(f"wall {self.name!r}: conductivity must be > 0 (W/(m K)), got {lam}")
+            object.__setattr__(self, "conductivity", lam)
+
+    @property
+    def isothermal(self) -> bool:
+        return self.temperature is not None
 
 
 @dataclass(frozen=True)
@@ -691,6 +723,8 @@ class HeatSolver:
         self.energy = dict(source=0.0, absorbed=0.0, flux=0.0, convection=0.0, boundary=0.0)
         if energy:
             self.energy.update({k: float(v) for k, v in energy.items() if k in self.energy})
+        #: heat [J] that entered through each linked condition since the start (walls, surfaces)
+        self.link_energy = {k: float((energy or {}).get(f"link:{k}", 0.0)) for k in self._links}
 
     # -- structure and values ---------------------------------------------------------------------
     @staticmethod
@@ -770,6 +804,39 @@ class HeatSolver:
             self.capacity = _ro(self._check_capacity(capacity))
         self._build_structure()
         return "structure"
+
+    def set_links(self, name: str, nodes, conductance, assemble: bool = True):
+        """New nodes and conductances G_i [W/K] of a fixed temperature held through links
+        (a surface condition, or a wall whose contacts changed): a change of the diagonal
+        only, the structure and the solver setup are kept. ``assemble=False`` leaves the
+        matrices to the next :meth:`update_values` (one assembly for several changes)."""
+        if name not in self._links:
+            raise BoundaryConditionError(f"no linked fixed-temperature condition named {name!r}; have "
+                                         f"{sorted(self._links)}")
+        nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
+        g = np.asarray(conductance, dtype=float).reshape(-1)
+        if g.shape != nd.shape or not np.all(np.isfinite(g)) or np.any(g < 0):
+            raise BoundaryConditionError(f"links of {name!r}: conductances must be finite, >= 0 and one per node "
+                                         f"({nd.size}), got shape {g.shape}")
+        if nd.size and (nd.min() < 0 or nd.max() >= self.n):
+            raise BoundaryConditionError(f"links of {name!r}: node index out of range 0..{self.n - 1}")
+        g = np.where(self.fixed[nd], 0.0, g)
+        self._links[name] = (nd, g)
+        self.nodes_of[name] = nd
+        link_G = np.zeros(self.n)
+        for k, (nk, gk) in self._links.items():
+            np.add.at(link_G, nk, gk)
+        self._link_G = link_G
+        self.h_area = _ro(self._conv_hA + link_G)
+        self._refresh_links()
+        if assemble:
+            self._assemble()
+
+    def link_flows(self, temperature=None) -> dict:
+        """Heat flow [W] into the network through each linked condition at ``temperature``
+        (default the current one): sum_i G_i (T_s - T_i)."""
+        T = self._T if temperature is None else np.asarray(temperature, dtype=float)
+        return {k: float(np.sum(g * (self._fixed_value[k] - T[nd]))) for k, (nd, g) in self._links.items()}
 
     @property
     def solver(self):
@@ -951,6 +1018,10 @@ class HeatSolver:
         Tth_u = Tu_theta_sum / n_sub
         boundary = dt * float(np.sum(self.system.group_flux(Tth_u, Tg))) if d.size else 0.0
         boundary += dt * float(np.sum(self._link_GT[u] - self._link_G[u] * Tth_u))
+        if self._links:
+            Tth = self._T.copy()
+            Tth[u] = Tth_u
+            info["link_energy"] = {k: dt * v for k, v in self.link_flows(Tth).items()}
         convection = dt * float(np.sum(self._conv_hAT[u] - self._conv_hA[u] * Tth_u))
         step = HeatStep(time=self.time + dt, dt=dt, n_substeps=n_sub,
                         source_energy=dt * float(np.sum(src[u])), absorbed_energy=dt * float(np.sum(src[d])),
@@ -981,6 +1052,8 @@ class HeatSolver:
         e["flux"] += step.flux_energy
         e["convection"] += step.convection_energy
         e["boundary"] += step.boundary_energy
+        for k, v in step.info.get("link_energy", {}).items():
+            self.link_energy[k] = self.link_energy.get(k, 0.0) + v
         return step
 
     # -- steady state ------------------------------------------------------------------------

@@ -1,0 +1,129 @@
+"""Granular contacts from positions (Verlet lists, sphere-wall overlaps), the contact laws'
+wall factors and softened-stiffness correction, and isothermal walls in the heat model: each
+against an exact answer (numpy only)."""
+import math
+
+import numpy as np
+import pytest
+
+from yade_electro.contacts import (WallGeometry, candidate_pairs, plane_contact_radius, triangle_distance,
+                                   wall_candidates, wall_overlaps)
+from yade_electro.conductance import make_law
+from yade_electro.coupled import ElectroThermalModel
+from yade_electro.errors import BoundaryConditionError
+from yade_electro.graph import ContactGraph
+from yade_electro.thermal import ThermalWall
+
+
+def test_candidate_pairs_are_every_close_pair():
+    rng = np.random.default_rng(3)
+    pos = rng.uniform(0, 0.02, (400, 3))
+    rad = rng.uniform(0.5e-3, 1e-3, 400)
+    skin = 0.3e-3
+    got = candidate_pairs(pos, rad, skin)
+    d = np.linalg.norm(pos[:, None] - pos[None], axis=2)
+    i, j = np.nonzero(np.triu(d < rad[:, None] + rad[None] + skin, 1))
+    assert np.array_equal(got, np.column_stack([i, j]))       # lexicographic, i < j
+
+
+def test_triangle_distance_against_dense_sampling():
+    rng = np.random.default_rng(5)
+    tri = np.array([[0, 0, 0], [1, 0, 0], [0.2, 0.8, 0]], float)
+    pts = rng.uniform(-1, 2, (300, 3))
+    u, v = np.meshgrid(np.linspace(0, 1, 301), np.linspace(0, 1, 301))
+    keep = u + v <= 1
+    samples = tri[0] + u[keep, None] * (tri[1] - tri[0]) + v[keep, None] * (tri[2] - tri[0])
+    brute = np.array([np.min(np.linalg.norm(samples - p, axis=1)) for p in pts])
+    got = triangle_distance(pts, np.repeat(tri[None], len(pts), axis=0))
+    assert np.all(got <= brute + 1e-12)                   # exact closest point: never farther
+    assert np.max(brute - got) < 5e-3                     # the sampling's resolution
+
+
+def test_plane_box_and_triangle_overlaps():
+    r = 1e-3
+    pos = np.array([[0, 0, 0.9e-3], [0, 0, -0.5e-3], [0, 0, 2e-3]])
+    rad = np.full(3, r)
+    plane = WallGeometry("plane", point=(0, 0, 0), normal=(0, 0, 1), two_sided=False)
+    nodes, dl = wall_overlaps(plane, pos, rad, *wall_candidates(plane, pos, rad, 1e-4))
+    assert nodes.tolist() == [0] and dl[0] == pytest.approx(0.1e-3)          # one-sided: not the one below
+    both = WallGeometry("plane", point=(0, 0, 0), normal=(0, 0, 1))
+    nodes, dl = wall_overlaps(both, pos, rad, *wall_candidates(both, pos, rad, 1e-4))
+    assert nodes.tolist() == [0, 1] and dl.tolist() == pytest.approx([0.1e-3, 0.5e-3])
+    box = WallGeometry("box", center=(0, 0, -1), axes=np.eye(3), extents=(1, 1, 1))   # top face at z = 0
+    out = pos[[0, 2]]                                   # spheres touch a box from outside
+    nodes, dl = wall_overlaps(box, out, rad[:2], *wall_candidates(box, out, rad[:2], 1e-4))
+    assert nodes.tolist() == [0] and dl[0] == pytest.approx(0.1e-3)
+    # a square of two triangles under the spheres: a sphere over their shared edge counts once
+    sq = np.array([[[-1, -1, 0], [1, -1, 0], [1, 1, 0]], [[-1, -1, 0], [1, 1, 0], [-1, 1, 0]]], float)
+    tris = WallGeometry("triangles", vertices=sq)
+    nodes, dl = wall_overlaps(tris, pos, rad, *wall_candidates(tris, pos, rad, 1e-4))
+    assert nodes.tolist() == [0, 1] and dl.tolist() == pytest.approx([0.1e-3, 0.5e-3])
+
+
+def test_plane_contact_radius_and_wall_factors():
+    r, dl = 2e-3, 1e-5
+    assert plane_contact_radius(r, dl)[()] == pytest.approx(math.sqrt(2 * r * dl - dl ** 2), rel=1e-12)
+    assert plane_contact_radius(r, dl, "hertz")[()] == pytest.approx(math.sqrt(r * dl), rel=1e-12)
+    assert plane_contact_radius(r, -1.0)[()] == 0.0
+    a = math.sqrt(2 * r * dl - dl ** 2)
+    assert make_law("contact").wall_factor(np.array([r]), np.array([dl]))[0] == pytest.approx(2 * a)
+    assert make_law("liggghts").wall_factor(np.array([r]), np.array([dl]))[0] == pytest.approx(
+        2 * math.sqrt(math.pi) * a)
+    with pytest.raises(ValueError, match="no sphere-wall contacts"):
+        make_law("continuum").wall_factor(np.array([r]), np.array([dl]))
+
+
+@pytest.mark.parametrize("correction, k", [("hertz", 1 / 3), ("hooke", 1 / 2), ("lethe", 1 / 5)])
+def test_softened_stiffness_correction(correction, k):
+    r, delta = 1e-3, 1e-6
+    g = ContactGraph(np.array([[0, 0, 0], [2 * r - delta, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
+    plain = make_law("contact", radius="hertz").factor(g)[0]
+    soft = make_law("contact", radius="hertz", stiffness_ratio=1e-3, correction=correction).factor(g)[0]
+    assert soft / plain == pytest.approx(1e-3 ** k, rel=1e-12)
+    with pytest.raises(ValueError, match="stiffness_ratio must be in"):
+        make_law("contact", stiffness_ratio=2.0)
+    with pytest.raises(ValueError, match="correction must be one of"):
+        make_law("liggghts", stiffness_ratio=0.5, correction="jkr")
+
+
+def _sphere_on_hot_plane(theta, dt, steps, wall_conductivity=None):
+    r, k, rho, c = 2e-3, 385.0, 8900.0, 172.0
+    g = ContactGraph(np.zeros((1, 3)), [r], np.zeros((0, 2)))
+    m = ElectroThermalModel(None, rho, c, k, 0.0, law="contact", volume_fraction=1.0, theta=theta,
+                            walls=[ThermalWall("plate", 100.0, wall_conductivity), ThermalWall("lid")])
+    dl = 0.1e-3
+    m.set_wall_contacts("plate", [0], [dl])
+    m.set_wall_contacts("lid", [0], [dl])          # adiabatic: conducts nothing
+    for _ in range(steps):
+        row = m.step(g, dt)
+    a = math.sqrt(2 * r * dl - dl ** 2)
+    k_e = k if wall_conductivity is None else 2 * k * wall_conductivity / (k + wall_conductivity)
+    tau = rho * c * 4 / 3 * math.pi * r ** 3 / (2 * k_e * a)
+    return row, tau
+
+
+def test_sphere_on_an_isothermal_wall_follows_the_exponential():
+    row, tau = _sphere_on_hot_plane("crank-nicolson", 1e-3, 400)
+    exact = 100.0 * (1 - math.exp(-row["time"] / tau))
+    assert row["T_mean"] == pytest.approx(exact, rel=1e-6)
+    # the wall's heat is the heat stored, and it is in boundary_heat
+    assert row["wall_heat:plate"] == pytest.approx(row["heat_content"], rel=1e-12)
+    assert row["boundary_heat"] == pytest.approx(row["heat_content"], rel=1e-12)
+    assert "wall_heat:lid" not in row and row["wall_contacts:plate"] == 1
+    # a steel wall under a copper sphere: the harmonic mean of the conductivities
+    row, tau = _sphere_on_hot_plane("crank-nicolson", 1e-3, 400, wall_conductivity=50.0)
+    assert row["T_mean"] == pytest.approx(100.0 * (1 - math.exp(-row["time"] / tau)), rel=1e-6)
+
+
+def test_wall_inputs_are_checked():
+    with pytest.raises(BoundaryConditionError, match="conductivity must be > 0"):
+        ThermalWall("w", 300.0, conductivity=-1.0)
+    with pytest.raises(BoundaryConditionError, match="names must be non-empty"):
+        ThermalWall("", 300.0)
+    with pytest.raises(BoundaryConditionError, match="walls= given with law 'continuum'"):
+        ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="continuum", walls=[ThermalWall("w", 1.0)])
+    m = ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="contact", walls=[ThermalWall("w", 1.0)])
+    with pytest.raises(BoundaryConditionError, match="no wall named"):
+        m.set_wall_contacts("x", [0], [1e-6])
+    with pytest.raises(ValueError, match="overlaps must be finite"):
+        m.set_wall_contacts("w", [0], [-1e-6])

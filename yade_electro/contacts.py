@@ -1,0 +1,254 @@
+"""Contacts of a granular bed found from positions: sphere pairs and sphere-wall contacts.
+
+A bed whose contacts change every step cannot afford to rebuild its networks at each
+change. The pairs are kept as a *Verlet list* (the device YADE's collider uses with its
+``verletDist``): every pair closer than ``r_i + r_j + skin`` is a candidate edge; a
+candidate conducts only while the two spheres overlap (its contact radius is 0 otherwise).
+The list holds every contact until some sphere has moved by more than ``skin / 2`` since
+it was made (two spheres then may have closed the gap by ``skin``): only then is it made
+again. Between two lists a changing contact set is a change of values on a kept structure.
+
+* :func:`candidate_pairs`: the Verlet list (scipy's cKDTree);
+* :class:`WallGeometry`: planes (YADE ``Wall``), boxes and triangles (``Facet``), in world
+  coordinates;
+* :func:`wall_overlaps`: the overlap delta = r - (distance from the centre to the wall) of
+  each candidate sphere-wall pair (0 when they do not touch);
+* :func:`plane_contact_radius`: the contact radius of a sphere on a plane, geometric
+  (a^2 = 2 r delta - delta^2) or Hertz (a = sqrt(r delta), R* = r).
+
+Units: metres.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+__all__ = ["candidate_pairs", "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps",
+           "plane_contact_radius", "triangle_distance"]
+
+
+def _ro(a):
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a
+
+
+def candidate_pairs(pos, radius, skin: float) -> np.ndarray:
+    """Every pair (i < j) with ``|x_i - x_j| < r_i + r_j + skin`` [m], as an (m, 2) array in
+    lexicographic order."""
+    from scipy.spatial import cKDTree
+    pos = np.asarray(pos, dtype=float)
+    radius = np.asarray(radius, dtype=float)
+    if pos.shape[0] < 2:
+        return np.zeros((0, 2), dtype=np.int64)
+    tree = cKDTree(pos)
+    pairs = tree.query_pairs(2.0 * float(radius.max()) + float(skin), output_type="ndarray").astype(np.int64)
+    if pairs.size == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    d = np.sqrt(((pos[pairs[:, 0]] - pos[pairs[:, 1]]) ** 2).sum(axis=1))
+    pairs = pairs[d < radius[pairs[:, 0]] + radius[pairs[:, 1]] + skin]
+    pairs.sort(axis=1)
+    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
+    return pairs[order]
+
+
+def max_displacement(pos, pos0) -> float:
+    """Largest distance [m] between two position sets of the same spheres."""
+    d = np.asarray(pos, dtype=float) - np.asarray(pos0, dtype=float)
+    return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d), initial=0.0)))
+
+
+@dataclass(frozen=True, eq=False)
+class WallGeometry:
+    """One conducting wall in world coordinates [m].
+
+    ``kind``:
+
+    * ``'plane'``: ``point`` (3,) and unit ``normal`` (3,); ``two_sided`` planes touch spheres
+      on both sides (YADE's ``Wall`` with ``sense=0``), else only on the normal's side;
+    * ``'box'``: ``center`` (3,), ``axes`` (3, 3) (rows: the box's unit axes) and ``extents``
+      (3,) half sizes; spheres touch it from outside (YADE's ``Box``);
+    * ``'triangles'``: ``vertices`` (k, 3, 3), one triangle per row (YADE facets, a facet
+      mesh given as one wall).
+    """
+
+    kind: str
+    point: Optional[np.ndarray] = None
+    normal: Optional[np.ndarray] = None
+    two_sided: bool = True
+    center: Optional[np.ndarray] = None
+    axes: Optional[np.ndarray] = None
+    extents: Optional[np.ndarray] = None
+    vertices: Optional[np.ndarray] = None
+
+    def __post_init__(self):
+        if self.kind == "plane":
+            p, nrm = np.asarray(self.point, float).reshape(3), np.asarray(self.normal, float).reshape(3)
+            ln = np.linalg.norm(nrm)
+            if not (np.all(np.isfinite(p)) and np.isfinite(ln) and ln > 0):
+                raise ValueError("a plane wall needs a finite point and a non-zero normal")
+            object.__setattr__(self, "point", _ro(p))
+            object.__setattr__(self, "normal", _ro(nrm / ln))
+        elif self.kind == "box":
+            c, ax = np.asarray(self.center, float).reshape(3), np.asarray(self.axes, float).reshape(3, 3)
+            e = np.asarray(self.extents, float).reshape(3)
+            if not (np.all(np.isfinite(c)) and np.all(np.isfinite(ax)) and np.all(e > 0)):
+                raise ValueError("a box wall needs a finite centre and axes and extents > 0")
+            for name, v in (("center", c), ("axes", ax), ("extents", e)):
+                object.__setattr__(self, name, _ro(v))
+        elif self.kind == "triangles":
+            v = np.asarray(self.vertices, float).reshape(-1, 3, 3)
+            if v.shape[0] == 0 or not np.all(np.isfinite(v)):
+                raise ValueError("a triangle wall needs at least one triangle with finite vertices")
+            object.__setattr__(self, "vertices", _ro(v))
+        else:
+            raise ValueError(f"wall kind must be 'plane', 'box' or 'triangles', got {self.kind!r}")
+
+    @property
+    def n_pieces(self) -> int:
+        """Triangles of a triangle wall, else 1."""
+        return self.vertices.shape[0] if self.kind == "triangles" else 1
+
+    def reach(self) -> np.ndarray:
+        """(pieces, 3) centres and (pieces,) radii of balls holding each piece (for the
+        candidate search); planes have an infinite ball."""
+        if self.kind == "triangles":
+            c = self.vertices.mean(axis=1)
+            r = np.sqrt(((self.vertices - c[:, None, :]) ** 2).sum(axis=2)).max(axis=1)
+            return c, r
+        if self.kind == "box":
+            return self.center[None, :], np.array([float(np.linalg.norm(self.extents))])
+        return self.point[None, :], np.array([np.inf])
+
+    def moved(self, other: "WallGeometry") -> float:
+        """Largest displacement [m] of this wall's defining points from ``other``'s (inf when
+        they are not comparable: another kind or size); planes and boxes compare their
+        corners or point plus normal turn (over a unit length)."""
+        if other is None or other.kind != self.kind or other.n_pieces != self.n_pieces:
+            return np.inf
+        if self.kind == "triangles":
+            return float(np.sqrt(((self.vertices - other.vertices) ** 2).sum(axis=2)).max())
+        if self.kind == "box":
+            corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
+
+            def pts(b):
+                return b.center + (corners * b.extents) @ b.axes
+            return float(np.sqrt(((pts(self) - pts(other)) ** 2).sum(axis=1)).max())
+        # a plane: its offset along the normal; a turn of the normal moves far points without
+        # limit, so any turn counts as a new list
+        if not np.allclose(self.normal, other.normal, rtol=0, atol=1e-12):
+            return np.inf
+        return float(abs((self.point - other.point) @ self.normal))
+
+
+def triangle_distance(points, triangles) -> np.ndarray:
+    """Distance [m] from each point (k, 3) to the triangle (k, 3, 3) of the same row (the
+    closest point of the triangle, faces, edges or corners; Ericson, Real-Time Collision
+    Detection, 5.1.5)."""
+    p = np.asarray(points, float)
+    t = np.asarray(triangles, float)
+    a, b, c = t[:, 0], t[:, 1], t[:, 2]
+    ab, ac, ap = b - a, c - a, p - a
+
+    def dot(u, v):
+        return np.einsum("ij,ij->i", u, v)
+    d1, d2 = dot(ab, ap), dot(ac, ap)
+    bp = p - b
+    d3, d4 = dot(ab, bp), dot(ac, bp)
+    cp = p - c
+    d5, d6 = dot(ab, cp), dot(ac, cp)
+    va = d3 * d6 - d5 * d4
+    vb = d5 * d2 - d1 * d6
+    vc = d1 * d4 - d3 * d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        denom = va + vb + vc
+        v = vb / denom
+        w = vc / denom
+        q = a + v[:, None] * ab + w[:, None] * ac                  # inside the face
+        # edges
+        t_ab = d1 / (d1 - d3)
+        t_ac = d2 / (d2 - d6)
+        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+    on_ab = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
+    on_ac = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
+    on_bc = (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)
+    q = np.where(on_bc[:, None], b + t_bc[:, None] * (c - b), q)
+    q = np.where(on_ac[:, None], a + t_ac[:, None] * ac, q)
+    q = np.where(on_ab[:, None], a + t_ab[:, None] * ab, q)
+    # corners
+    q = np.where(((d6 >= 0) & (d5 <= d6))[:, None], c, q)
+    q = np.where(((d3 >= 0) & (d4 <= d3))[:, None], b, q)
+    q = np.where(((d1 <= 0) & (d2 <= 0))[:, None], a, q)
+    return np.sqrt(((p - q) ** 2).sum(axis=1))
+
+
+def _distance(wall: WallGeometry, pos, piece):
+    if wall.kind == "plane":
+        s = (pos - wall.point) @ wall.normal
+        return np.abs(s) if wall.two_sided else np.where(s >= 0, s, np.inf)
+    if wall.kind == "box":
+        local = (pos - wall.center) @ wall.axes.T
+        out = np.clip(np.abs(local) - wall.extents, 0.0, None)
+        return np.sqrt((out ** 2).sum(axis=1))
+    return triangle_distance(pos, wall.vertices[piece])
+
+
+def wall_candidates(wall: WallGeometry, pos, radius, skin: float):
+    """Sphere-piece pairs that may touch within the next ``skin / 2`` of motion: (spheres,
+    pieces) index arrays, spheres sorted."""
+    pos = np.asarray(pos, float)
+    radius = np.asarray(radius, float)
+    if wall.kind != "triangles":
+        d = _distance(wall, pos, None)
+        s = np.flatnonzero(d < radius + skin)
+        return s, np.zeros(s.size, dtype=np.int64)
+    from scipy.spatial import cKDTree
+    c, rc = wall.reach()
+    tree = cKDTree(pos)
+    reach = rc + float(radius.max()) + float(skin)
+    lists = tree.query_ball_point(c, reach)
+    pieces = np.repeat(np.arange(len(lists)), [len(x) for x in lists])
+    spheres = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=pieces.size)
+    if spheres.size:
+        d = triangle_distance(pos[spheres], wall.vertices[pieces])
+        keep = d < radius[spheres] + skin
+        spheres, pieces = spheres[keep], pieces[keep]
+    order = np.lexsort((pieces, spheres))
+    return spheres[order], pieces[order]
+
+
+def wall_overlaps(wall: WallGeometry, pos, radius, spheres, pieces):
+    """The spheres touching ``wall`` among the candidate (sphere, piece) pairs and their
+    overlap delta = r - distance [m] (> 0): ``(nodes, overlap)``, nodes sorted. A sphere
+    touching several triangles of one mesh (an edge or a corner between them) counts once,
+    with the deepest overlap (declare surfaces that meet at an angle, e.g. a drum shell and
+    its baffles, as separate walls so that a sphere in the corner touches both)."""
+    pos = np.asarray(pos, float)
+    radius = np.asarray(radius, float)
+    spheres = np.asarray(spheres, dtype=np.int64)
+    if spheres.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    dl = radius[spheres] - _distance(wall, pos[spheres], pieces)
+    touch = dl > 0
+    s, dl = spheres[touch], dl[touch]
+    if s.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
+    nodes, inv = np.unique(s, return_inverse=True)
+    deepest = np.zeros(nodes.size)
+    np.maximum.at(deepest, inv, dl)
+    return nodes, deepest
+
+
+def plane_contact_radius(radius, overlap, model: str = "geometric") -> np.ndarray:
+    """Contact radius a [m] of a sphere of ``radius`` pressed by ``overlap`` into a plane:
+    'geometric' a^2 = 2 r delta - delta^2 (the circle where the sphere crosses the plane),
+    'hertz' a = sqrt(r delta) (R* = r for a sphere on a half-space). 0 where delta <= 0."""
+    r = np.asarray(radius, float)
+    dl = np.clip(np.asarray(overlap, float), 0.0, None)
+    if model == "hertz":
+        return np.sqrt(r * dl)
+    if model == "geometric":
+        return np.sqrt(np.clip(2.0 * r * dl - dl ** 2, 0.0, None))
+    raise ValueError(f"contact radius model must be 'geometric' or 'hertz', got {model!r}")
