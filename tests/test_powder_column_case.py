@@ -35,3 +35,13 @@ def test_column_follows_the_hertz_chain(run_yade_script, tmp_path):
     assert abs(row["slope_geometric"] + 1 / 3) < 2e-3
     for r in row["rows"]:
         assert r["R_geometric"] / r["R_hertz"] == pytest.approx(1 / math.sqrt(2), rel=2e-3)
+    # the plate as an electrode: slope -1/3; YADE's wall contact has R* = r / 2 (measured), and
+    # against that contact the plate resistance is exact
+    assert abs(row["slope_error_pct_plate"]) < 1e-3
+    assert row["plate_r_star_over_r"] == pytest.approx(0.5, rel=1e-5)
+    assert row["max_R_error_pct_plate_vs_yade_wall"] < 1e-3
+    # against Hertz's sphere on a half-space (R* = r) the plate contact's share of R, whose
+    # radius is 2^(1/6) too large, comes out 1 - 2^(-1/6) low
+    w = 2 ** (-1 / 3)                   # the plate contact's resistance over a sphere-sphere one
+    share = w / (row["n"] - 1 + w)
+    assert row["max_R_error_pct_plate"] == pytest.approx(100 * share * (1 - 2 ** (-1 / 6)), rel=1e-3)

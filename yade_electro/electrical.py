@@ -47,7 +47,10 @@ class ElectrodeSpec:
     ``select``: the element layer the electrode is (paper 000's convention: a perfect conductor
     through the selected elements' centres). ``surface``: a surface of the container (e.g.
     ``container.face('top')``, see :mod:`yade_electro.boundary`): the electrode is that surface,
-    each element with boundary faces on it connected through its half cell. Give one of them.
+    each element with boundary faces on it connected through its half cell. ``wall=True``: a
+    wall of a granular bed (a plate), each particle touching it connected through its contact
+    (the contact law's sphere-wall factor, :meth:`ElectricalModel.set_wall_contacts` gives the
+    contacts). Give one of them.
     """
 
     name: str
@@ -55,17 +58,21 @@ class ElectrodeSpec:
     potential: Optional[float] = None
     current: Optional[float] = None
     surface: object = None
+    wall: bool = False
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not self.name:
             raise BoundaryConditionError(f"electrode names must be non-empty strings, got {self.name!r}")
-        if (self.select is None) == (self.surface is None):
+        if not isinstance(self.wall, bool):
+            raise BoundaryConditionError(f"electrode {self.name!r}: wall= must be True or False")
+        if (self.select is not None) + (self.surface is not None) + self.wall != 1:
             raise BoundaryConditionError(f"electrode {self.name!r}: give select= (an element layer: a predicate, ids "
-                                         "or a mask) or surface= (a surface of the container), one of them")
+                                         "or a mask), surface= (a surface of the container) or wall= (a wall of a "
+                                         "granular bed), one of them")
         if self.surface is not None:
             from .boundary import check_surface
             check_surface(self.surface, f"electrode {self.name!r}")
-        else:
+        elif not self.wall:
             check_selector(self.select, f"electrode {self.name!r}: select")
         if (self.potential is None) == (self.current is None):
             raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
@@ -82,7 +89,7 @@ class ElectrodeSpec:
         return float(self.potential if self.fixed else self.current)
 
     def resolve(self, graph: ContactGraph) -> Electrode:
-        if self.surface is not None:
+        if self.surface is not None or self.wall:
             raise BoundaryConditionError(f"electrode {self.name!r} is a surface: resolve it through ElectricalModel")
         return Electrode(self.name, select_nodes(graph, self.select, self.name, "electrode"), self.potential,
                          self.current)
@@ -96,7 +103,7 @@ def electrode_specs(electrodes) -> List[ElectrodeSpec]:
             if isinstance(spec, ElectrodeSpec):
                 out.append(spec)
             elif isinstance(spec, Mapping):
-                unknown = set(spec) - {"select", "surface", "potential", "current"}
+                unknown = set(spec) - {"select", "surface", "potential", "current", "wall"}
                 if unknown:
                     raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give "
                                                  "select= or surface=, and potential= (V) or current= (A)")
@@ -160,7 +167,16 @@ class ElectricalModel:
                 raise BoundaryConditionError(f"measure={measure} must name two different electrodes of {names}")
         self.measure = tuple(measure) if measure else None
         self.memberships: Dict[str, Membership] = {s.name: Membership(s.name, s.select, reselect)
-                                                   for s in self.specs if s.surface is None}
+                                                   for s in self.specs if s.surface is None and not s.wall}
+        self.walls = [s.name for s in self.specs if s.wall]
+        if self.walls:
+            try:
+                self.law.wall_factor(np.ones(1), np.zeros(1))
+            except ValueError as exc:
+                raise BoundaryConditionError(f"wall electrodes {self.walls} with law {self.law.name!r}: {exc}") from None
+        self._wall_contacts = {w: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
+        self._wall_nodes = {}                 # name -> the nodes of its edges in the kept problem
+        self._walls_stale = False
         self.container = container if container is not None else getattr(self.law, "container", None)
         from .boundary import BoundaryOfGraph, SurfaceMembership
         self.surfaces: Dict[str, SurfaceMembership] = {s.name: SurfaceMembership(s.name, s.surface)
@@ -272,6 +288,37 @@ class ElectricalModel:
             raise BoundaryConditionError(f"resistivity has {np.shape(rho)[0]} values but the packing has {n} elements")
         return edge_resistivity(rho, edges)
 
+    def set_wall_contacts(self, name: str, nodes, overlap):
+        """The particles touching wall electrode ``name`` (node indices of the next graph) and
+        their overlaps [m] (> 0). Particles that touched it before keep their edge with a zero
+        conductance (the structure is kept); a particle touching it for the first time makes a
+        new structure."""
+        if name not in self._wall_contacts:
+            raise BoundaryConditionError(f"no wall electrode named {name!r}; have {self.walls}")
+        nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
+        dl = np.asarray(overlap, dtype=float).reshape(-1)
+        if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
+            raise ValueError(f"wall electrode {name!r}: overlaps must be finite, >= 0 and one per node")
+        self._wall_contacts[name] = (nd, dl)
+        self._walls_stale = True
+
+    def _wall_factor(self, name, graph, nodes):
+        """Factors g [m] of the kept edges ``nodes`` of wall ``name`` for its current contacts."""
+        nd, dl = self._wall_contacts[name]
+        over = np.zeros(nodes.size)
+        if nd.size:
+            pos = np.searchsorted(nodes, nd)
+            over[pos] = dl
+        return self.law.wall_factor(graph.radius[nodes], over)
+
+    def _walls_fit(self) -> bool:
+        """True when every particle touching a wall electrode has an edge to it."""
+        for name, (nd, _) in self._wall_contacts.items():
+            kept = self._wall_nodes.get(name)
+            if kept is None or (nd.size and not np.all(np.isin(nd, kept))):
+                return False
+        return True
+
     def _surface_contact(self, spec, graph):
         """The elements a surface electrode touches (made once, kept by element id)."""
         return self.surfaces[spec.name].contact(graph, self._boundary)
@@ -280,7 +327,22 @@ class ElectricalModel:
         n = graph.n_nodes
         electrodes, surf_edges, surf_g, surf_nodes = [], [], [], []
         for s in self.specs:
-            if s.surface is not None:
+            if s.wall:
+                nd, _ = self._wall_contacts[s.name]
+                if nd.size == 0:
+                    raise BoundaryConditionError(
+                        f"wall electrode {s.name!r} touches no particle: no current can enter there (is the bed "
+                        "pressed against it? a wall conducts through overlapping contacts)")
+                nodes = np.unique(nd)
+                if nodes.max() >= n:
+                    raise BoundaryConditionError(f"wall electrode {s.name!r}: contact node beyond the {n} elements")
+                self._wall_nodes[s.name] = nodes
+                k = n + len(surf_nodes)
+                surf_nodes.append(k)
+                surf_edges.append(np.column_stack([nodes, np.full(nodes.size, k)]))
+                surf_g.append(self._wall_factor(s.name, graph, nodes))
+                electrodes.append(Electrode(s.name, [k], potential=s.potential, current=s.current))
+            elif s.surface is not None:
                 contact = self._surface_contact(s, graph)
                 k = n + len(surf_nodes)
                 surf_nodes.append(k)
@@ -292,6 +354,13 @@ class ElectricalModel:
                 electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
         self._surface_edges = np.concatenate(surf_edges) if surf_edges else np.zeros((0, 2), dtype=np.int64)
         self._surface_factor = np.concatenate(surf_g) if surf_g else np.zeros(0)
+        offsets = np.cumsum([0] + [len(g) for g in surf_g])
+        self._wall_slices = {}
+        names = [sp.name for sp in self.specs if sp.surface is not None or sp.wall]
+        for k, name in enumerate(names):
+            if name in self._wall_nodes:
+                self._wall_slices[name] = slice(int(offsets[k]), int(offsets[k + 1]))
+        self._walls_stale = False
         self.n_elements = n
         edges = np.concatenate([self.network.edges, self._surface_edges])
         c = self._full_conductance(n)
@@ -316,10 +385,17 @@ class ElectricalModel:
             raise TypeError(f"expected a ContactGraph, got {type(graph).__name__}")
         kind = self.network.update(graph)
         reselect = any(m.reselect for m in self.memberships.values())
-        if self.problem is None or kind == "structure" or (kind == "topology" and reselect):
+        if (self.problem is None or kind == "structure" or (kind == "topology" and reselect)
+                or (self.walls and not self._walls_fit())):
             self._rho_stale = False
             self._build(graph)
             return "structure"
+        if self.walls and self._walls_stale:
+            for name, sl in self._wall_slices.items():
+                self._surface_factor[sl] = self._wall_factor(name, graph, self._wall_nodes[name])
+            self._walls_stale = False
+            if kind is None:
+                kind = "geometry"
         if kind is None:
             if not self._rho_stale:
                 return None

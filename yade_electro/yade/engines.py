@@ -42,9 +42,10 @@ from ..errors import BoundaryConditionError, ThermalError
 from ..geometry import Shape, as_shape
 from ..history import History
 from ..materials import real_number
-from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource
+from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
 from . import persistence, registry
 from .runtime import import_yade
+from .granular import GranularReader, check_wall_bodies
 from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute
 
 __all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ensure_thermal_state", "engine_class"]
@@ -54,6 +55,17 @@ log = logging.getLogger(__name__)
 
 def _is_predicate(obj) -> bool:
     return callable(obj) and hasattr(obj, "aabb") and hasattr(obj, "dim") and not isinstance(obj, Shape)
+
+
+def _electrode_walls(electrodes) -> dict:
+    """name -> body ids of the electrodes given as ``dict(wall=ids, ...)`` (granular mode)."""
+    out = {}
+    if isinstance(electrodes, dict):
+        for name, spec in electrodes.items():
+            if isinstance(spec, dict) and spec.get("wall") is not None:
+                ids = spec["wall"]
+                out[name] = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
+    return out
 
 
 def _check_period(iterPeriod):
@@ -75,7 +87,16 @@ class _Engine:
         self._resume = resume
         self.label = label if resume is not None else registry.claim_label(label, self.DEFAULT_LABEL, self.O)
         self.iterPeriod = _check_period(iterPeriod)
-        self.reader = SceneReader(self.O, **reader_options)
+        opts = dict(reader_options)
+        skin, walls = opts.pop("skin", 0.2), opts.pop("walls", None)
+        if opts["bonds"] == "contacts":
+            self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls)
+        else:
+            if walls:
+                raise BoundaryConditionError("walls (walls=, or electrodes with wall=) conduct in the granular mode "
+                                             "only (bonds='contacts'): a bonded solid's boundaries are surfaces "
+                                             "(surface=)")
+            self.reader = SceneReader(self.O, **opts)
         if history_mode not in ("w", "a", "x"):
             raise ValueError(f"history_mode must be 'w', 'a' or 'x', got {history_mode!r}")
         self.history_path = None if history is None else os.fspath(history)
@@ -254,9 +275,12 @@ class ElectricalEngine(_Engine):
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, container=None, O=None, _resume=None):
+                 reselect: bool = False, container=None, skin: float = 0.2, O=None, _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
-                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
+                              skin=skin, walls=_electrode_walls(electrodes) or None)
+        self._options_bonds = bonds
+        self._electrode_walls = _electrode_walls(electrodes)
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
@@ -274,8 +298,23 @@ class ElectricalEngine(_Engine):
         if container is not None and not isinstance(container, Shape):
             container = as_shape(container)
         self.container = container
+        granular = self._options_bonds == "contacts"
         if law is None:
-            law = "voronoi" if container is not None else "continuum"
+            law = "contact" if granular else ("voronoi" if container is not None else "continuum")
+        from ..conductance import GranularLaw, check_law_name, make_law
+        check_law_name(law)
+        try:
+            is_contact_law = isinstance(make_law(law, **{k: v for k, v in law_params.items() if k != "container"}),
+                                        GranularLaw)
+        except (TypeError, ValueError):
+            is_contact_law = law in ("contact", "liggghts")
+        if granular and not is_contact_law:
+            raise ValueError(f"law {law!r} is a law of bonded solids, but bonds='contacts' (a granular bed): use "
+                             "law='contact' or 'liggghts' (conduction through the contact areas)")
+        if not granular and is_contact_law:
+            raise ValueError(f"law {law!r} conducts through contact overlaps, but bonds='cohesive' (a bonded solid "
+                             "whose bonds do not overlap): use bonds='contacts' for a granular bed, or a solid's law "
+                             "('voronoi', 'continuum')")
         if law == "voronoi" and container is not None:
             law_params["container"] = law_params.get("container") or container
         if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
@@ -297,10 +336,17 @@ class ElectricalEngine(_Engine):
             spec = dict(spec)
             if spec.get("select") is not None:
                 spec["select"] = self._normalise_selector(spec["select"])
-            unknown = set(spec) - {"select", "surface", "potential", "current"}
+            unknown = set(spec) - {"select", "surface", "potential", "current", "wall"}
             if unknown:
-                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select= or "
-                                             "surface=, and potential= (V) or current= (A)")
+                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select=, "
+                                             "surface= or wall=, and potential= (V) or current= (A)")
+            if spec.get("wall") is not None:
+                if self._options_bonds != "contacts":
+                    raise BoundaryConditionError(f"electrode {name!r}: wall= electrodes are walls of a granular bed "
+                                                 "(bonds='contacts'); a bonded solid's electrodes are surfaces "
+                                                 "(surface=) or element layers (select=)")
+                check_wall_bodies(self.O, name, spec["wall"])
+                spec["wall"] = True
             specs.append(ElectrodeSpec(name, **spec))
         self._resistivity = resistivity
         return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
@@ -311,7 +357,9 @@ class ElectricalEngine(_Engine):
         out = {}
         for s in self.model.specs:
             value = {"potential": s.potential} if s.fixed else {"current": s.current}
-            if s.surface is not None:
+            if s.wall:
+                out[s.name] = dict(wall=list(self._electrode_walls[s.name]), **value)
+            elif s.surface is not None:
                 out[s.name] = dict(surface=self.model.surfaces[s.name].saved, **value)
             else:
                 ids = self.model.memberships[s.name].ids
@@ -333,7 +381,7 @@ class ElectricalEngine(_Engine):
                     bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
                     move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                     bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
-                    plot=self.plot, reselect=o["reselect"], container=self.container)
+                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"])
 
     def _save_state(self):
         persistence.save_state(self.O, self.label, {
@@ -344,7 +392,14 @@ class ElectricalEngine(_Engine):
         if self._resume is not None:
             for k, v in (self._resume_state.get("values") or {}).items():
                 self.model.set_electrode(k, v)
+        self._feed_electrode_walls()
         self.model.update(graph)
+
+    def _feed_electrode_walls(self):
+        if self.model is None:
+            return
+        for name in self.model.walls:
+            self.model.set_wall_contacts(name, *self.reader.wall_contacts(name))
 
     # -- stepping ------------------------------------------------------------------------
     def set_electrode(self, name: str, value: float):
@@ -353,6 +408,7 @@ class ElectricalEngine(_Engine):
 
     def _step(self):
         graph = self.reader.read()
+        self._feed_electrode_walls()
         sol = self.model.solve(graph)
         if self.write_back and sol is not self._written:
             write_body_attribute(self.reader.bodies, self.write_back, sol.potential)
@@ -482,11 +538,29 @@ class ElectroThermalEngine(ElectricalEngine):
                  history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
-                 label: Optional[str] = None, reselect: bool = False, container=None, O=None, _resume=None):
+                 label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin: float = 0.2,
+                 O=None, _resume=None):
+        wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
-                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls)
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
+                              skin=skin, walls={w.name: ids for w, ids in wall_specs if w.isothermal} or None)
+        self._electrode_walls = _electrode_walls(electrodes)
+        clash = set(self._electrode_walls) & {w.name for w, _ in wall_specs}
+        if clash:
+            raise BoundaryConditionError(f"{sorted(clash)} name both a thermal wall and an electrode; give them "
+                                         "different names (they may be the same bodies)")
+        if self._electrode_walls:
+            reader_options["walls"] = {**(reader_options["walls"] or {}), **self._electrode_walls}
+        self._options_bonds = bonds
+        self._walls = {w.name: dict(bodies=list(ids), temperature=w.temperature, conductivity=w.conductivity)
+                       for w, ids in wall_specs}
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
                     write_back if electrodes is not None else None, plot)
+        if wall_specs and bonds != "contacts":
+            raise BoundaryConditionError("walls= conduct in the granular mode only (bonds='contacts'): a bonded "
+                                         "solid's boundaries are surfaces (fixed=[FixedTemperature(..., surface=...)])")
+        for w, ids in wall_specs:
+            check_wall_bodies(self.O, w.name, ids)
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         if temperature is None:
@@ -527,13 +601,16 @@ class ElectroThermalEngine(ElectricalEngine):
                              time_scale=time_scale, thermal_solver=thermal_solver, steady=steady,
                              coupled_options=dict(coupled_options or {}))
         extra = dict(coupled_options or {})
+        if bonds == "contacts" and "cell_volume" not in extra:
+            extra.setdefault("volume_fraction", 1.0)     # a particle is its own volume
         if self.model is None:
             extra.setdefault("law", law)
             extra.setdefault("law_params", self._law_params)
         extra.setdefault("container", self.container)
         self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
                                            eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
-                                           sources=heat_sources, thermal_solver=thermal_solver, **extra)
+                                           sources=heat_sources, thermal_solver=thermal_solver,
+                                           walls=[w for w, _ in wall_specs], **extra)
         self._last_time = float(self.O.time)
         self._states_checked = -1
         if initial_temperature is not None and _resume is None:
@@ -544,6 +621,53 @@ class ElectroThermalEngine(ElectricalEngine):
             self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
             self.coupled.restore_temperatures(self._read_temperatures)
         self._finish(history_mode)
+
+    @staticmethod
+    def _wall_specs(walls):
+        """[(ThermalWall, body ids)] from ``walls={name: dict(bodies=..., temperature=K | None,
+        conductivity=W/(m K))}`` (checked here; the bodies' shapes by the reader)."""
+        if walls is None:
+            return []
+        if not isinstance(walls, dict):
+            raise BoundaryConditionError("walls= must be a dict name -> dict(bodies=ids, temperature=K or None "
+                                         "(adiabatic), conductivity=W/(m K))")
+        out = []
+        for name, spec in walls.items():
+            if not isinstance(spec, dict) or "bodies" not in spec:
+                raise BoundaryConditionError(f"wall {name!r}: give dict(bodies=ids, temperature=K or None, "
+                                             "conductivity=...)")
+            unknown = set(spec) - {"bodies", "temperature", "conductivity"}
+            if unknown:
+                raise BoundaryConditionError(f"wall {name!r}: unknown key(s) {sorted(unknown)}; give bodies=, "
+                                             "temperature=, conductivity=")
+            ids = spec["bodies"]
+            ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
+            out.append((ThermalWall(name, spec.get("temperature"), spec.get("conductivity")), ids))
+        return out
+
+    def _feed_walls(self):
+        self._feed_electrode_walls()
+        # adiabatic walls carry no heat: their contacts are not looked for (their bodies are
+        # checked when the engine is built)
+        for name in self._walls:
+            if name not in self.reader.walls:
+                continue
+            self.coupled.set_wall_contacts(name, *self.reader.wall_contacts(name))
+
+    def wall_heat(self) -> Dict[str, float]:
+        """Heat [J] each isothermal wall gave the bed since the start (negative: taken)."""
+        return dict(self.coupled.heat.link_energy)
+
+    def contact_heat_flow(self):
+        """Per contact: (body id pairs (m, 2), conductance G [W/K], heat flow [W] from the
+        first body to the second) of the contacts that conduct now."""
+        net, heat = self.coupled.network, self.coupled.heat
+        G = heat.conductance
+        on = G > 0
+        e = net.edges[on]
+        T = heat.temperature
+        ids = self.body_ids
+        return np.column_stack([ids[e[:, 0]], ids[e[:, 1]]]), G[on], G[on] * (T[e[:, 0]] - T[e[:, 1]])
 
     def _initial_temperatures(self, table, default):
         """A function graph -> starting temperatures from ``{body id: K}`` (checked now)."""
@@ -579,6 +703,8 @@ class ElectroThermalEngine(ElectricalEngine):
                       bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=None, plot=self.plot,
                       reselect=o["reselect"], container=self.container)
         t = dict(self._thermal)
+        t["walls"] = dict(self._walls) or None
+        t["skin"] = self._options["skin"]
         bcs = {}
         for group in ("fixed", "flux", "convection"):
             out = []
@@ -601,7 +727,7 @@ class ElectroThermalEngine(ElectricalEngine):
         persistence.save_state(self.O, self.label, {
             "iter": int(self.O.iter), "time": float(self.O.time), "mech_time": self._last_time,
             "values": dict(self.model.values) if self.model is not None else {},
-            "thermal_time": self.coupled.time, "energy": dict(heat.energy) if heat is not None else {},
+            "thermal_time": self.coupled.time, "energy": self.coupled.energy_ledger,
             "fixed_values": heat.fixed_values if heat is not None else {},
             "rows": len(self.history)})
 
@@ -609,6 +735,7 @@ class ElectroThermalEngine(ElectricalEngine):
         if self._resume is not None and self.model is not None:
             for k, v in (self._resume_state.get("values") or {}).items():
                 self.model.set_electrode(k, v)
+        self._feed_walls()
         self.coupled.refresh(graph)
         if self._resume is not None:
             for k, v in (self._resume_state.get("fixed_values") or {}).items():
@@ -630,6 +757,7 @@ class ElectroThermalEngine(ElectricalEngine):
 
     def _step(self, steady=None):
         graph = self.reader.read()
+        self._feed_walls()
         if self.thermal_dt is not None:
             dt = self.thermal_dt
         else:

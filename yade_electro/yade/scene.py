@@ -183,7 +183,12 @@ class SceneReader:
             return False
         pid, body = self._probe
         try:
-            return not (len(self.O.bodies) > pid and self.O.bodies[pid] == body)
+            if len(self.O.bodies) <= pid:
+                return True
+            now = self.O.bodies[pid]
+            # an erased probe (a particle that left) is not a new scene: the next full read,
+            # which the body count or volume change causes, takes another probe
+            return now is not None and not (now == body)
         except Exception:
             return True
 

@@ -1,0 +1,170 @@
+"""The granular mode in the real YADE (each test a fresh ``yade-electro -n -x`` process): a
+bed falling onto a wall with contacts changing at every call (energy conserved with an
+adiabatic wall, wall heat = heat stored with an isothermal one), beds with no contact,
+particles leaving, bad set-ups refused in the script, and the drum and container cases at
+small sizes."""
+import os
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "cases"))
+
+BED = r'''
+import json
+import numpy as np
+from yade import pack, utils
+from yade_electro.yade import HeatEngine
+mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
+floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
+sp = pack.SpherePack()
+sp.makeCloud((0, 0, GAP), (0.012, 0.012, 0.03), rMean=1e-3, rRelFuzz=0.2, seed=1)
+ids = sp.toSimulation(material=mat)
+O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+             InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                             [Law2_ScGeom_FrictPhys_CundallStrack()]),
+             NewtonIntegrator(gravity=(0, 0, GRAVITY), damping=0.3)]
+O.dt = 0.5 * utils.PWaveTimeStep()
+hot = {i: 373.15 for i in ids if O.bodies[i].state.pos[2] > 0.015}
+e = HeatEngine(8900, 172, 385, 273.15, initial_temperature=hot, bonds="contacts", law=LAW,
+               walls={"floor": dict(bodies=floor, temperature=WALL_T)}, theta=THETA, iterPeriod=10)
+O.engines = O.engines + [e.runner]
+heat_init = e.coupled.summary()["heat_content"]
+rows = []
+for k in range(CHUNKS):
+    O.run(2000, True)
+    if ERASE and k == 1:
+        O.bodies.erase(ids[0])          # a particle leaves the domain
+    rows.append(e.coupled.summary())
+r = rows[-1]
+T = e.temperature
+print(json.dumps({"heat_init": heat_init, "heat": r["heat_content"], "wall_heat": r.get("wall_heat:floor"), "boundary": r["boundary_heat"],
+                  "heat0": rows[0]["heat_content"], "finite": bool(np.all(np.isfinite(T))), "n": int(T.size),
+                  "T_min": float(T.min()), "T_max": float(T.max()), "builds": e.reader.list_builds,
+                  "calls": e.reader.calls, "full_reads": e.reader.full_reads,
+                  "contacts": [int(np.sum(e.coupled.heat.conductance > 0))],
+                  "wall_contacts": r.get("wall_contacts:floor"),
+                  "C_T": float(np.sum(e.coupled.capacity * (T - 273.15))),
+                  "state_temp_ok": bool(abs(O.bodies[ids[-1]].state.temp - e.temperature_by_id[ids[-1]]) < 1e-12)}))
+'''
+
+
+def _bed(run_yade_script, tmp_path, wall_t="None", law="'contact'", theta="'explicit'", erase=False, gap="0.001",
+         gravity="-9.81", chunks=6):
+    src = (BED.replace("WALL_T", wall_t).replace("LAW", law).replace("THETA", theta).replace("ERASE", repr(erase))
+           .replace("GAP", gap).replace("GRAVITY", gravity).replace("CHUNKS", str(chunks)))
+    return run_yade_script(src, timeout=300, cwd=tmp_path, check=True).result
+
+
+def test_falling_bed_conserves_energy_with_an_adiabatic_wall(run_yade_script, tmp_path):
+    out = _bed(run_yade_script, tmp_path)
+    assert out["finite"] and out["builds"] > 3 and out["full_reads"] == 1     # contacts changed, no full read
+    assert out["contacts"][0] > 20                     # the bed landed (it spreads on the open floor)
+    # adiabatic: the capacity-weighted temperature sum does not move (1e-9 relative)
+    initial = out["heat_init"]
+    assert initial > 0 and abs(out["heat"] - initial) <= 1e-9 * abs(initial)
+    assert out["wall_heat"] is None and out["boundary"] == 0.0
+    assert 273.15 < out["T_min"] and out["T_max"] < 373.15 and out["state_temp_ok"]
+
+
+@pytest.mark.parametrize("theta", ["'explicit'", "'backward-euler'"])
+def test_isothermal_wall_heat_is_the_heat_stored(run_yade_script, tmp_path, theta):
+    out = _bed(run_yade_script, tmp_path, wall_t="473.15", theta=theta)
+    assert out["wall_contacts"] > 10 and out["wall_heat"] > 0
+    # the heat stored since the start is what the wall gave (1e-9)
+    assert out["heat"] - out["heat_init"] == pytest.approx(out["wall_heat"], rel=1e-9)
+    assert out["boundary"] == pytest.approx(out["wall_heat"], rel=1e-12)
+
+
+def test_a_bed_without_contacts_keeps_its_temperatures(run_yade_script, tmp_path):
+    # no gravity, a loose cloud: no sphere touches another or the wall
+    out = _bed(run_yade_script, tmp_path, wall_t="473.15", gap="0.004", gravity="0", chunks=2)
+    assert out["finite"] and out["contacts"] == [0] and out["wall_contacts"] == 0
+    assert out["heat"] == out["heat_init"] and out["wall_heat"] == 0.0
+
+
+def test_a_particle_leaving_the_bed(run_yade_script, tmp_path):
+    out = _bed(run_yade_script, tmp_path, wall_t="473.15", erase=True)
+    assert out["finite"] and out["full_reads"] == 2          # the erased body was seen once
+    assert out["wall_heat"] > 0
+
+
+BAD = r'''
+import json
+from yade import pack, utils
+from yade_electro.yade import HeatEngine
+mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
+floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
+s = O.bodies.append([utils.sphere((0, 0, 1e-3), 1e-3, material=mat), utils.sphere((0, 0, 3e-3), 1e-3, material=mat)])
+out = {}
+cases = {
+    "wall_on_sphere": dict(bonds="contacts", walls={"w": dict(bodies=s[0], temperature=300.0)}),
+    "wall_missing": dict(bonds="contacts", walls={"w": dict(bodies=99, temperature=300.0)}),
+    "wall_bad_key": dict(bonds="contacts", walls={"w": dict(bodies=floor, temp=300.0)}),
+    "contact_law_bonded": dict(bonds="cohesive", law="contact"),
+    "solid_law_granular": dict(bonds="contacts", law="continuum"),
+    "walls_bonded": dict(bonds="cohesive", law="continuum", walls={"w": dict(bodies=floor, temperature=300.0)}),
+    "bad_skin": dict(bonds="contacts", skin=-1.0),
+}
+for name, kw in cases.items():
+    try:
+        HeatEngine(8900, 172, 385, 273.15, label="bad_" + name, **kw)
+        out[name] = "accepted"
+    except Exception as exc:
+        out[name] = f"{type(exc).__name__}: {exc}"
+from yade_electro.yade import ElectricalEngine
+for name, kw in {"wall_electrode_no_contact": dict(bonds="contacts"),
+                 "wall_electrode_bonded": dict(bonds="cohesive", law="continuum")}.items():
+    try:
+        ElectricalEngine(1e-7, {"plate": dict(wall=floor, potential=0.0), "top": dict(select=[s[1]], potential=1.0)},
+                         label="bad_" + name, **kw)
+        out[name] = "accepted"
+    except Exception as exc:
+        out[name] = f"{type(exc).__name__}: {exc}"
+print(json.dumps(out))
+'''
+
+
+def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path):
+    out = run_yade_script(BAD, timeout=120, cwd=tmp_path, check=True).result
+    assert "is a Sphere, not a wall" in out["wall_on_sphere"]
+    assert "no body 99" in out["wall_missing"]
+    assert "unknown key(s) ['temp']" in out["wall_bad_key"]
+    assert out["contact_law_bonded"].startswith("ValueError") and "bonds='contacts'" in out["contact_law_bonded"]
+    assert out["solid_law_granular"].startswith("ValueError") and "law='contact'" in out["solid_law_granular"]
+    assert "granular mode only" in out["walls_bonded"]
+    assert "skin must be finite and > 0" in out["bad_skin"]
+    assert "touches no particle" in out["wall_electrode_no_contact"]
+    assert "granular mode only" in out["wall_electrode_bonded"]
+
+
+def test_drum_case_small(run_yade_script, tmp_path):
+    res = run_yade_script(os.path.join(ROOT, "cases", "rotating_drum.py"), "--n", "200", "--duration", "0.2",
+                          "--sample", "0.05", "--baffles", "--out", str(tmp_path), timeout=600, check=True).result
+    assert res["case"] == "rotating_drum" and res["wall"] == "baffles" and res["n"] > 150
+    assert res["balance_rel"] < 1e-9 and res["wall_heat_J"] > 0
+    assert -0.5 < res["final_lacey"] < 1.2
+    assert os.path.exists(res["png"])
+
+
+def test_container_case_small(run_yade_script, tmp_path):
+    res = run_yade_script(os.path.join(ROOT, "cases", "container_heating.py"), "--n", "150", "--settle", "0.4",
+                          "--dt", "5", "--out", str(tmp_path), timeout=600, check=True).result
+    assert res["case"] == "container_heating" and res["n"] == 150
+    assert res["balance_rel"] < 1e-6 and res["t90_centre_s"] is not None
+    assert res["wall_contacts"]["side"] > 0 and res["wall_contacts"]["bottom"] > 0
+    assert all(os.path.exists(p) for p in res["vtk"])
+
+
+def test_lacey_index_limits():
+    import numpy as np
+    import rotating_drum as drum
+    rng = np.random.default_rng(0)
+    pos = rng.uniform(0, 0.1, (4000, 3))
+    segregated = pos[:, 0] < 0.048           # on a cell boundary (cells of 4 diameters, 16 mm)
+    assert drum.lacey_index(pos, segregated) < 0.05
+    mixed = rng.random(4000) < 0.5
+    assert drum.lacey_index(pos, mixed) == pytest.approx(1.0, abs=0.15)

@@ -1,0 +1,319 @@
+"""The contact graph of a granular bed in YADE (``bonds='contacts'``), kept cheap while the
+contacts change every step, and the bed's walls.
+
+Reading YADE's interactions from Python costs microseconds per contact: too much for a bed
+whose contacts change at every step. :class:`GranularReader` reads instead the positions
+with YADE's C++ bulk reader (``utils.coordsAndDisplacements``, about 1 ms for 5,000
+bodies) at every call, and finds the contacts itself: the edges are a Verlet list of the
+pairs closer than ``r_i + r_j + skin`` (:func:`yade_electro.contacts.candidate_pairs`), kept
+until some sphere (or wall) has moved by more than half the skin, and a pair conducts only
+while its spheres overlap (the contact laws give g = 0 otherwise). These are the contacts
+YADE's ``Ig2_Sphere_Sphere_ScGeom`` makes real (overlap > 0, detection factor 1); a larger
+``interactionDetectionFactor`` makes YADE interactions at a distance, which conduct nothing
+here either. Between two lists the engine sees a change of values on a kept structure.
+
+Walls: ``walls={name: dict(bodies=ids, ...)}`` names YADE bodies whose shape is ``Wall``,
+``Box`` or ``Facet`` (a facet mesh such as ``geom.facetCylinder`` given as one wall). Their
+geometry is read at every call (a few Python reads per body) and the spheres touching them
+are found with the same skin (:mod:`yade_electro.contacts`).
+
+Full reads (a Python loop over the bodies) happen when the body count or the total sphere
+volume changes (spheres added, erased, or a radius changed) or the scene was replaced.
+Units: SI.
+"""
+from __future__ import annotations
+
+import logging
+from collections import Counter
+from typing import Dict, List, Optional
+
+import numpy as np
+
+from ..contacts import WallGeometry, candidate_pairs, max_displacement, wall_candidates, wall_overlaps
+from ..errors import BoundaryConditionError, GraphError
+from ..graph import ContactGraph
+from .runtime import import_yade
+
+__all__ = ["GranularReader", "WALL_SHAPES", "check_wall_bodies"]
+
+log = logging.getLogger(__name__)
+
+#: YADE shapes that can be walls
+WALL_SHAPES = ("Wall", "Box", "Facet")
+
+
+def check_wall_bodies(O, name, ids):
+    """The bodies of wall ``name``, checked: they exist and are all walls of one kind."""
+    if isinstance(ids, (int, np.integer)) and not isinstance(ids, bool):
+        ids = [ids]
+    try:
+        ids = [int(i) for i in ids]
+    except (TypeError, ValueError):
+        raise BoundaryConditionError(f"wall {name!r}: bodies= must be a body id or a list of body ids, got "
+                                     f"{ids!r}") from None
+    if not ids:
+        raise BoundaryConditionError(f"wall {name!r}: bodies= is empty")
+    kinds = set()
+    for i in ids:
+        b = O.bodies[i] if 0 <= i < len(O.bodies) else None
+        if b is None:
+            raise BoundaryConditionError(f"wall {name!r}: there is no body {i} in the scene")
+        kind = type(b.shape).__name__
+        if kind not in WALL_SHAPES:
+            raise BoundaryConditionError(f"wall {name!r}: body {i} is a {kind}, not a wall; a wall is a body of "
+                                         f"shape {', '.join(WALL_SHAPES)} (spheres are the particles)")
+        kinds.add(kind)
+    if len(kinds) > 1:
+        raise BoundaryConditionError(f"wall {name!r}: its bodies mix shapes {sorted(kinds)}; give one wall per shape")
+    kind = kinds.pop()
+    if kind != "Facet" and len(ids) > 1:
+        raise BoundaryConditionError(f"wall {name!r}: give one {kind} body per wall (only facets form a mesh)")
+    return kind, ids
+
+
+def _rotation(q):
+    """Rotation matrix of a YADE Quaternion."""
+    return _rotations(np.array([[q[0], q[1], q[2], q[3]]]))[0]
+
+
+def _rotations(q):
+    """Rotation matrices (k, 3, 3) of unit quaternions (k, 4) stored (x, y, z, w), as YADE's
+    ``Quaternion[i]`` gives them."""
+    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+
+
+class _WallReader:
+    """Reads one wall's world geometry from its YADE bodies."""
+
+    def __init__(self, O, name, ids):
+        self.name = name
+        self.kind, self.ids = check_wall_bodies(O, name, ids)
+        self.O = O
+        if self.kind == "Facet":
+            self._local = np.array([[[v[0], v[1], v[2]] for v in O.bodies[i].shape.vertices] for i in self.ids])
+
+    def geometry(self, coords=None, slot=None) -> WallGeometry:
+        """The wall now; ``coords`` (bodies, 3) [m] from YADE's bulk reader and ``slot`` (the
+        row of each existing body id) give the facets' positions without a read per body."""
+        bodies = [self.O.bodies[i] for i in self.ids]
+        if self.kind == "Wall":
+            b = bodies[0]
+            axis, sense = int(b.shape.axis), int(b.shape.sense)
+            normal = np.zeros(3)
+            normal[axis] = 1.0 if sense >= 0 else -1.0
+            p = b.state.pos
+            return WallGeometry("plane", point=(p[0], p[1], p[2]), normal=normal, two_sided=sense == 0)
+        if self.kind == "Box":
+            b = bodies[0]
+            p, e = b.state.pos, b.shape.extents
+            return WallGeometry("box", center=(p[0], p[1], p[2]), axes=_rotation(b.state.ori).T,
+                                extents=(e[0], e[1], e[2]))
+        states = [b.state for b in bodies]
+        if coords is not None:
+            pos = coords[[slot[i] for i in self.ids]]
+        else:
+            pos = np.array([tuple(st.pos) for st in states], dtype=float)
+        quat = np.array([(q[0], q[1], q[2], q[3]) for q in (st.ori for st in states)], dtype=float)
+        R = _rotations(quat)
+        verts = pos[:, None, :] + np.einsum("kij,kvj->kvi", R, self._local)
+        return WallGeometry("triangles", vertices=verts)
+
+
+class GranularReader:
+    """Contact graph of a granular bed, read from YADE's ``O`` at every call.
+
+    Parameters
+    ----------
+    O : yade.Omega, optional
+    mask : int, optional
+        Keep only spheres with ``b.mask & mask``.
+    skin : float
+        Verlet skin, in units of the smallest sphere radius (default 0.2). A larger skin keeps
+        a list longer at the price of more candidate pairs.
+    walls : dict name -> body id or list of ids, optional
+        The walls whose contacts are wanted (see module doc).
+
+    Attributes
+    ----------
+    graph : the last ContactGraph (edges: the candidate pairs)
+    list_builds : how many Verlet lists were made
+    full_reads, calls, ignored, last_change : as :class:`~yade_electro.yade.scene.SceneReader`
+    """
+
+    bonds = "contacts"
+
+    def __init__(self, O=None, mask: Optional[int] = None, skin: float = 0.2, walls: Optional[Dict] = None):
+        try:
+            skin = float(skin)
+        except (TypeError, ValueError):
+            raise ValueError(f"skin must be a number > 0 (in smallest radii), got {skin!r}") from None
+        if not (np.isfinite(skin) and skin > 0):
+            raise ValueError(f"skin must be finite and > 0 (in smallest radii), got {skin!r}")
+        if mask is not None and (isinstance(mask, bool) or int(mask) != mask):
+            raise ValueError(f"mask must be an integer (YADE group mask), got {mask!r}")
+        if O is None:
+            O = import_yade().Omega()
+        self.O, self.mask, self.skin = O, mask, skin
+        self.walls = {name: _WallReader(O, name, ids) for name, ids in (walls or {}).items()}
+        self.graph: Optional[ContactGraph] = None
+        self.ignored: Counter = Counter()
+        self.full_reads = self.list_builds = self.calls = 0
+        self.geometry_reads = 0
+        self.last_change: Optional[str] = None
+        self._revision = -1
+        self._bodies: List = []
+        self._stamp = None
+        self._probe = None
+        self._wall_geom: Dict[str, WallGeometry] = {}
+        self._wall_contacts: Dict[str, tuple] = {}
+
+    # -- public --------------------------------------------------------------------------
+    def read(self) -> ContactGraph:
+        """The current graph (a new revision whenever the spheres moved)."""
+        self.calls += 1
+        self.last_change = None
+        reason = "first read" if self.graph is None else self._changed()
+        if reason:
+            self._full_read()
+            self.last_change = reason
+        coords = self._coordinates()
+        pos = coords[self._node_slot]
+        if not np.all(np.isfinite(pos)):
+            bad = self.graph.ids[~np.all(np.isfinite(pos), axis=1)]
+            raise GraphError(f"spheres {bad[:10].tolist()} have non-finite positions (the mechanics blew up?)")
+        geoms = {name: w.geometry(coords, self._slot_of) for name, w in self.walls.items()}
+        self.geometry_reads += 1
+        rebuild = bool(reason)
+        if not rebuild:
+            moved = max_displacement(pos, self._list_pos)
+            walls_moved = max([geoms[k].moved(self._list_walls[k]) for k in geoms], default=0.0)
+            rebuild = 2.0 * moved > self._skin_m or moved + walls_moved > self._skin_m
+        if rebuild:
+            self._make_lists(pos, geoms)
+            if not reason:
+                self.last_change = "new Verlet list"
+        elif not np.array_equal(pos, self.graph.pos):
+            self._revision += 1
+            self.graph = self.graph.with_positions(pos, self._revision)
+            self.last_change = self.last_change or "geometry"
+        self._wall_geom = geoms
+        r = self.graph.radius
+        self._wall_contacts = {name: wall_overlaps(geoms[name], self.graph.pos, r, *self._wall_cand[name])
+                               for name in self.walls}
+        return self.graph
+
+    def wall_contacts(self, name: str):
+        """(nodes, overlaps [m]) of the spheres touching wall ``name`` at the last read."""
+        return self._wall_contacts[name]
+
+    def wall_geometry(self, name: str) -> WallGeometry:
+        return self._wall_geom[name]
+
+    def invalidate(self):
+        self.graph = None
+
+    @property
+    def bodies(self) -> list:
+        return self._bodies
+
+    @property
+    def scene_replaced(self) -> bool:
+        if self._probe is None:
+            return False
+        pid, body = self._probe
+        try:
+            if len(self.O.bodies) <= pid:
+                return True
+            now = self.O.bodies[pid]
+            # an erased probe (a particle that left) is not a new scene: the next full read,
+            # which the body count or volume change causes, takes another probe
+            return now is not None and not (now == body)
+        except Exception:
+            return True
+
+    def _coordinates(self) -> np.ndarray:
+        """Centres (existing bodies, 3) [m] of every body, by YADE's C++ bulk reader."""
+        U = import_yade().utils
+        cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
+        if len(cols[0]) != self._n_existing:
+            raise GraphError("the number of bodies changed since the last full read (call invalidate())")
+        return np.column_stack([np.fromiter(c, dtype=float, count=len(c)) for c in cols])
+
+    def positions(self) -> np.ndarray:
+        """Current centres (n, 3) [m] of the graph's spheres (YADE's C++ bulk reader)."""
+        return self._coordinates()[self._node_slot]
+
+    # -- internals -----------------------------------------------------------------------
+    def _stamp_now(self):
+        U = import_yade().utils
+        return (len(self.O.bodies), float(U.getSpheresVolume()))
+
+    def _changed(self) -> Optional[str]:
+        if self.scene_replaced:
+            return "scene replaced"
+        stamp = self._stamp_now()
+        if stamp != self._stamp:
+            names = ("body count", "sphere volume")
+            return "changed " + ", ".join(n for n, a, b in zip(names, stamp, self._stamp) if a != b)
+        return None
+
+    def _full_read(self):
+        yade = import_yade()
+        Sphere = yade.Sphere
+        ids, pos, rad, bodies, existing = [], [], [], [], []
+        ignored = Counter()
+        for b in self.O.bodies:
+            if b is None:
+                continue
+            existing.append(b.id)
+            if self.mask is not None and not (b.mask & self.mask):
+                ignored["masked out"] += 1
+                continue
+            if b.isClump or b.isClumpMember:
+                ignored["clump"] += 1
+                continue
+            if not isinstance(b.shape, Sphere):
+                ignored[type(b.shape).__name__] += 1
+                continue
+            p = b.state.pos
+            ids.append(b.id)
+            pos.append((p[0], p[1], p[2]))
+            rad.append(b.shape.radius)
+            bodies.append(b)
+        if not ids:
+            raise GraphError("the simulation has no spherical bodies to conduct through "
+                             f"(bodies: {len(self.O.bodies)}, left out: {dict(ignored) or 'none'}); "
+                             "add spheres, or check the mask")
+        rad = np.asarray(rad, dtype=float)
+        ids = np.asarray(ids, dtype=np.int64)
+        bad = ~(np.isfinite(rad) & (rad > 0))
+        if np.any(bad):
+            raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
+                             f"{rad[bad][:5].tolist()}")
+        slot = {bid: k for k, bid in enumerate(existing)}
+        self._slot_of = slot
+        self._node_slot = np.array([slot[int(i)] for i in ids], dtype=np.int64)
+        self._n_existing = len(existing)
+        self._bodies = bodies
+        self._probe = (int(ids[0]), bodies[0])
+        self._stamp = self._stamp_now()
+        self.ignored = ignored
+        self.full_reads += 1
+        self._skin_m = self.skin * float(rad.min())
+        self._revision += 1
+        self.graph = ContactGraph(np.asarray(pos, dtype=float), rad, np.zeros((0, 2), dtype=np.int64), ids,
+                                  self._revision)
+
+    def _make_lists(self, pos, geoms):
+        g = self.graph
+        edges = candidate_pairs(pos, g.radius, self._skin_m)
+        self._revision += 1
+        self.graph = ContactGraph(pos, g.radius, edges, g.ids, self._revision)
+        self._list_pos = self.graph.pos
+        self._list_walls = dict(geoms)
+        self._wall_cand = {name: wall_candidates(geoms[name], pos, g.radius, self._skin_m) for name in self.walls}
+        self.list_builds += 1
