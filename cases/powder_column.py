@@ -184,8 +184,10 @@ def plot(out, path):
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ff = np.logspace(np.log10(F[0]), np.log10(F[-1]), 50)
     ax.loglog(ff, chain_resistance(ff, out["n"]), "k-", label="exact chain, Hertz: slope -1/3")
-    for m, mk in (("hertz", "o"), ("geometric", "s")):
-        ax.loglog(F, [r[f"R_{m}"] for r in out["rows"]], mk, label=f"DEM, {m} radius: slope {out[f'slope_{m}']:.4f}")
+    ax.loglog(ff, plate_chain_resistance(ff, out["n"]), "k--", label="exact, top sphere to plate (Hertz)")
+    for m, mk, what in (("hertz", "o", "hertz radius"), ("geometric", "s", "geometric radius"),
+                        ("plate", "^", "to the plate, hertz")):
+        ax.loglog(F, [r[f"R_{m}"] for r in out["rows"]], mk, label=f"DEM, {what}: slope {out[f'slope_{m}']:.4f}")
     ax.set_xlabel("F [N]")
     ax.set_ylabel("R [ohm]")
     ax.set_title(f"{out['n']} spheres in a column")

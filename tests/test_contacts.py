@@ -127,3 +127,18 @@ def test_wall_inputs_are_checked():
         m.set_wall_contacts("x", [0], [1e-6])
     with pytest.raises(ValueError, match="overlaps must be finite"):
         m.set_wall_contacts("w", [0], [-1e-6])
+
+
+def test_feng_pipe_law():
+    from yade_electro.conductance import PipeLaw
+    r, w, a = 1e-3, 5e-3, 0.2e-3
+    d = 2 * math.sqrt(r ** 2 - a ** 2)                    # half chord a
+    g = ContactGraph(np.array([[0, 0, 0], [d, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
+    alpha = math.asin(a / r)
+    f = -math.log(alpha) + 1.5 + alpha ** 2 / 36
+    # two pipes in series, each (f / (pi k)) per unit length, over the width w: G = k pi w / (2 f)
+    assert make_law("pipe", width=w).factor(g)[0] == pytest.approx(math.pi * w / (2 * f), rel=1e-9)
+    apart = ContactGraph(np.array([[0, 0, 0], [3 * r, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
+    assert make_law("pipe", width=w).factor(apart)[0] == 0.0
+    with pytest.raises(ValueError, match="needs width="):
+        make_law("pipe")

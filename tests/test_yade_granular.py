@@ -168,3 +168,50 @@ def test_lacey_index_limits():
     assert drum.lacey_index(pos, segregated) < 0.05
     mixed = rng.random(4000) < 0.5
     assert drum.lacey_index(pos, mixed) == pytest.approx(1.0, abs=0.15)
+
+
+SAVED_BED = r'''
+import json
+import numpy as np
+from yade import pack, utils
+from yade_electro.yade import HeatEngine, attach
+def build():
+    mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
+    floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
+    sp = pack.SpherePack()
+    sp.makeCloud((0, 0, 0.001), (0.006, 0.006, 0.02), rMean=1e-3, rRelFuzz=0.2, seed=2)
+    ids = sp.toSimulation(material=mat)
+    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                                 [Ip2_FrictMat_FrictMat_FrictPhys()], [Law2_ScGeom_FrictPhys_CundallStrack()]),
+                 NewtonIntegrator(gravity=(0, 0, -9.81), damping=0.3)]
+    O.dt = 0.5 * utils.PWaveTimeStep()
+    O.run(4000, True)
+    e = HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact", theta="backward-euler",
+                   walls={"floor": dict(bodies=floor, temperature=373.15)}, thermal_dt=1e-3, iterPeriod=10,
+                   history="h.csv")
+    O.engines = O.engines + [e.runner]
+    return e
+def figures(e):
+    last = e.history.rows[-1]
+    return dict(T={str(k): v for k, v in e.temperature_by_id.items()}, rows=len(e.history),
+                wall_heat=last["wall_heat:floor"], heat=last["heat_content"], time=e.coupled.time)
+'''
+
+
+def test_granular_save_and_load_continues(run_yade_script, tmp_path):
+    import numpy as np
+    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
+    ref_dir.mkdir(), run_dir.mkdir()
+    ref = run_yade_script(SAVED_BED + "e = build()\nO.run(2000, True)\nprint(json.dumps(figures(e)))\n",
+                          cwd=ref_dir, check=True).result
+    run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\nO.save('bed.yade.gz')\nprint('{}')\n",
+                    cwd=run_dir, check=True)
+    out = run_yade_script(SAVED_BED + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(1000, True)\n"
+                          "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
+    assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
+    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
+    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
+    assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
+    assert out["wall_heat"] == pytest.approx(ref["wall_heat"], rel=1e-9) and ref["wall_heat"] > 0
+    assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)

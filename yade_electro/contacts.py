@@ -25,7 +25,7 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["candidate_pairs", "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps",
+__all__ = ["sphere_tree", "candidate_pairs", "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps",
            "plane_contact_radius", "triangle_distance"]
 
 
@@ -35,15 +35,20 @@ def _ro(a):
     return a
 
 
-def candidate_pairs(pos, radius, skin: float) -> np.ndarray:
-    """Every pair (i < j) with ``|x_i - x_j| < r_i + r_j + skin`` [m], as an (m, 2) array in
-    lexicographic order."""
+def sphere_tree(pos):
+    """A KD-tree of the centres (scipy's cKDTree), to share between the searches of one list."""
     from scipy.spatial import cKDTree
+    return cKDTree(np.asarray(pos, dtype=float))
+
+
+def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
+    """Every pair (i < j) with ``|x_i - x_j| < r_i + r_j + skin`` [m], as an (m, 2) array in
+    lexicographic order; ``tree``: :func:`sphere_tree` of ``pos`` if already made."""
     pos = np.asarray(pos, dtype=float)
     radius = np.asarray(radius, dtype=float)
     if pos.shape[0] < 2:
         return np.zeros((0, 2), dtype=np.int64)
-    tree = cKDTree(pos)
+    tree = sphere_tree(pos) if tree is None else tree
     pairs = tree.query_pairs(2.0 * float(radius.max()) + float(skin), output_type="ndarray").astype(np.int64)
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64)
@@ -195,18 +200,17 @@ def _distance(wall: WallGeometry, pos, piece):
     return triangle_distance(pos, wall.vertices[piece])
 
 
-def wall_candidates(wall: WallGeometry, pos, radius, skin: float):
+def wall_candidates(wall: WallGeometry, pos, radius, skin: float, tree=None):
     """Sphere-piece pairs that may touch within the next ``skin / 2`` of motion: (spheres,
-    pieces) index arrays, spheres sorted."""
+    pieces) index arrays, spheres sorted; ``tree``: :func:`sphere_tree` of ``pos`` if made."""
     pos = np.asarray(pos, float)
     radius = np.asarray(radius, float)
     if wall.kind != "triangles":
         d = _distance(wall, pos, None)
         s = np.flatnonzero(d < radius + skin)
         return s, np.zeros(s.size, dtype=np.int64)
-    from scipy.spatial import cKDTree
     c, rc = wall.reach()
-    tree = cKDTree(pos)
+    tree = sphere_tree(pos) if tree is None else tree
     reach = rc + float(radius.max()) + float(skin)
     lists = tree.query_ball_point(c, reach)
     pieces = np.repeat(np.arange(len(lists)), [len(x) for x in lists])

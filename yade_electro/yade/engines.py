@@ -301,13 +301,8 @@ class ElectricalEngine(_Engine):
         granular = self._options_bonds == "contacts"
         if law is None:
             law = "contact" if granular else ("voronoi" if container is not None else "continuum")
-        from ..conductance import GranularLaw, check_law_name, make_law
-        check_law_name(law)
-        try:
-            is_contact_law = isinstance(make_law(law, **{k: v for k, v in law_params.items() if k != "container"}),
-                                        GranularLaw)
-        except (TypeError, ValueError):
-            is_contact_law = law in ("contact", "liggghts")
+        from ..conductance import is_contact_law as _is_contact_law
+        is_contact_law = _is_contact_law(law)
         if granular and not is_contact_law:
             raise ValueError(f"law {law!r} is a law of bonded solids, but bonds='contacts' (a granular bed): use "
                              "law='contact' or 'liggghts' (conduction through the contact areas)")
