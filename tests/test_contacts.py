@@ -136,6 +136,7 @@ def test_feng_pipe_law():
     g = ContactGraph(np.array([[0, 0, 0], [d, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
     alpha = math.asin(a / r)
     f = -math.log(alpha) + 1.5 + alpha ** 2 / 36
+    assert PipeLaw.pipe_bracket(alpha) == pytest.approx(f, rel=1e-15)
     # two pipes in series, each (f / (pi k)) per unit length, over the width w: G = k pi w / (2 f)
     assert make_law("pipe", width=w).factor(g)[0] == pytest.approx(math.pi * w / (2 * f), rel=1e-9)
     apart = ContactGraph(np.array([[0, 0, 0], [3 * r, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
