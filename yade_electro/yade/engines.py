@@ -239,10 +239,12 @@ class ElectricalEngine(_Engine):
     ----------
     resistivity : float
         rho_e [ohm m].
-    electrodes : dict name -> dict(select=... | surface=..., potential=V | current=A)
+    electrodes : dict name -> dict(select=... | surface=... | wall=..., potential=V | current=A)
         ``select``: an element layer (predicate, ids, mask; paper 000's electrodes).
         ``surface``: a surface of the container (``container.face('top')``, a ``Plane``, a
         region): the electrode acts at that surface, through each touching element's half cell.
+        ``wall``: body id(s) of a ``Wall``, ``Box`` or facet mesh of a granular bed
+        (``bonds='contacts'``): each particle touching it conducts through its contact.
     law : str, optional
         Conductance law; default ``'voronoi'`` when the container is known, else
         ``'continuum'`` (paper 000's transmission-surface model).
@@ -258,7 +260,10 @@ class ElectricalEngine(_Engine):
     history_mode : {'w', 'a', 'x'}
         Replace (saying so), append to, or refuse an existing file.
     bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check, sweep_calls :
-        see :class:`~yade_electro.yade.scene.SceneReader`
+        see :class:`~yade_electro.yade.scene.SceneReader` (``bonds='cohesive'``, a bonded solid)
+    skin : float
+        ``bonds='contacts'`` (a granular bed): the Verlet skin in smallest radii (see
+        :class:`~yade_electro.yade.granular.GranularReader`); positions are read at every call.
     write_back : str or None
         Body attribute that receives each element's potential [V] (default 'potential');
         None to skip. YADE's own attributes are refused.
@@ -520,6 +525,11 @@ class ElectroThermalEngine(ElectricalEngine):
         does the same once, from the script.
     thermal_solver : linear solver of the implicit heat step ('cg' default)
     coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
+    walls : dict name -> dict(bodies=ids, temperature=K or None, conductivity=W/(m K)), optional
+        Walls of a granular bed (``bonds='contacts'``): ``Wall``, ``Box`` or facet-mesh bodies,
+        isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.thermal.ThermalWall``.
+        Their heat is in the history (``wall_heat:<name>``) and in :meth:`wall_heat`.
+    skin : Verlet skin of the granular mode (see ElectricalEngine)
     """
 
     DEFAULT_LABEL = "electrothermal"
