@@ -273,6 +273,9 @@ class ElectroThermalModel:
         dl = np.asarray(overlap, dtype=float).reshape(-1)
         if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
             raise ValueError(f"wall {name!r}: overlaps must be finite, >= 0 and one per node")
+        old_nd, old_dl = self._wall_contacts[name]
+        if np.array_equal(nd, old_nd) and np.array_equal(dl, old_dl):
+            return                                  # the same contacts: nothing to update
         self._wall_contacts[name] = (nd, dl)
         self._walls_applied = None
 
