@@ -19,8 +19,8 @@ Set-up
 * Heat: ``HeatEngine(bonds='contacts', law='contact')`` (H = 2 k a, the geometric contact
   radius of the overlap, no softened-stiffness correction: paper 002 uses the overlaps as
   they come) every 10 steps on the elapsed time, explicit (forward Euler, sub-cycled if the
-  step ever exceeds the stable one C_i / sum G: with these contacts it is about 0.1 s, against
-  a thermal step of 3e-4 s, so one sub-step), walls as above.
+  step ever exceeds the stable one C_i / sum G; with these small contacts the 3e-4 s thermal
+  step runs as one sub-step), walls as above.
 
 Outputs, sampled every ``--sample`` s
 -------------------------------------
