@@ -88,7 +88,7 @@ class _Engine:
         self.label = label if resume is not None else registry.claim_label(label, self.DEFAULT_LABEL, self.O)
         self.iterPeriod = _check_period(iterPeriod)
         opts = dict(reader_options)
-        skin, walls = opts.pop("skin", 0.2), opts.pop("walls", None)
+        skin, walls = opts.pop("skin", "auto"), opts.pop("walls", None)
         if opts["bonds"] == "contacts":
             self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls)
         else:
@@ -261,9 +261,10 @@ class ElectricalEngine(_Engine):
         Replace (saying so), append to, or refuse an existing file.
     bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check, sweep_calls :
         see :class:`~yade_electro.yade.scene.SceneReader` (``bonds='cohesive'``, a bonded solid)
-    skin : float
-        ``bonds='contacts'`` (a granular bed): the Verlet skin in smallest radii (see
-        :class:`~yade_electro.yade.granular.GranularReader`); positions are read at every call.
+    skin : 'auto' or float
+        ``bonds='contacts'`` (a granular bed): the Verlet skin in smallest radii, adapted to the
+        motion by default (see :class:`~yade_electro.yade.granular.GranularReader`); positions
+        are read at every call.
     write_back : str or None
         Body attribute that receives each element's potential [V] (default 'potential');
         None to skip. YADE's own attributes are refused.
@@ -280,7 +281,7 @@ class ElectricalEngine(_Engine):
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, container=None, skin: float = 0.2, O=None, _resume=None):
+                 reselect: bool = False, container=None, skin="auto", O=None, _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
                               skin=skin, walls=_electrode_walls(electrodes) or None)
@@ -543,7 +544,7 @@ class ElectroThermalEngine(ElectricalEngine):
                  history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
-                 label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin: float = 0.2,
+                 label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
                  O=None, _resume=None):
         wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,

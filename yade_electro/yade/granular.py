@@ -132,8 +132,11 @@ class GranularReader:
     O : yade.Omega, optional
     mask : int, optional
         Keep only spheres with ``b.mask & mask``.
-    skin : float
-        Verlet skin, in units of the smallest sphere radius (default 0.2). A larger skin keeps
+    skin : float or 'auto'
+        Verlet skin, in units of the smallest sphere radius. ``'auto'`` (default) starts at 0.2
+        and adapts it to how the bed moves between calls: a list that lasted at most 2 calls
+        makes the next skin 1.5 times larger (up to 1.0), one that lasted 20 calls or more 1.25
+        times smaller (down to 0.05). A number keeps that skin. A larger skin keeps
         a list longer at the price of more candidate pairs.
     walls : dict name -> body id or list of ids, optional
         The walls whose contacts are wanted (see module doc).
@@ -147,11 +150,17 @@ class GranularReader:
 
     bonds = "contacts"
 
-    def __init__(self, O=None, mask: Optional[int] = None, skin: float = 0.2, walls: Optional[Dict] = None):
+    #: the adaptive skin's start, bounds and thresholds (see ``skin``)
+    SKIN_START, SKIN_MIN, SKIN_MAX = 0.2, 0.05, 1.0
+
+    def __init__(self, O=None, mask: Optional[int] = None, skin="auto", walls: Optional[Dict] = None):
+        self.adaptive = isinstance(skin, str) and skin == "auto"
+        if self.adaptive:
+            skin = self.SKIN_START
         try:
             skin = float(skin)
         except (TypeError, ValueError):
-            raise ValueError(f"skin must be a number > 0 (in smallest radii), got {skin!r}") from None
+            raise ValueError(f"skin must be 'auto' or a number > 0 (in smallest radii), got {skin!r}") from None
         if not (np.isfinite(skin) and skin > 0):
             raise ValueError(f"skin must be finite and > 0 (in smallest radii), got {skin!r}")
         if mask is not None and (isinstance(mask, bool) or int(mask) != mask):
@@ -311,6 +320,14 @@ class GranularReader:
 
     def _make_lists(self, pos, geoms):
         g = self.graph
+        if self.adaptive and self.list_builds:
+            lasted = self.calls - self._built_at
+            if lasted <= 2:
+                self.skin = min(1.5 * self.skin, self.SKIN_MAX)
+            elif lasted >= 20:
+                self.skin = max(self.skin / 1.25, self.SKIN_MIN)
+            self._skin_m = self.skin * float(g.radius.min())
+        self._built_at = self.calls
         tree = sphere_tree(pos)
         edges = candidate_pairs(pos, g.radius, self._skin_m, tree)
         self._revision += 1
