@@ -34,6 +34,7 @@ from ..contacts import (WallGeometry, candidate_pairs, max_displacement, sphere_
 from ..errors import BoundaryConditionError, GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
+from .scene import bulk_coordinates, probe_replaced, read_spheres
 
 __all__ = ["GranularReader", "WALL_SHAPES", "check_wall_bodies"]
 
@@ -190,7 +191,7 @@ class GranularReader:
         if reason:
             self._full_read()
             self.last_change = reason
-        coords = self._coordinates()
+        coords = bulk_coordinates(self._n_existing)
         pos = coords[self._node_slot]
         if not np.all(np.isfinite(pos)):
             bad = self.graph.ids[~np.all(np.isfinite(pos), axis=1)]
@@ -232,30 +233,11 @@ class GranularReader:
 
     @property
     def scene_replaced(self) -> bool:
-        if self._probe is None:
-            return False
-        pid, body = self._probe
-        try:
-            if len(self.O.bodies) <= pid:
-                return True
-            now = self.O.bodies[pid]
-            # an erased probe (a particle that left) is not a new scene: the next full read,
-            # which the body count or volume change causes, takes another probe
-            return now is not None and not (now == body)
-        except Exception:
-            return True
-
-    def _coordinates(self) -> np.ndarray:
-        """Centres (existing bodies, 3) [m] of every body, by YADE's C++ bulk reader."""
-        U = import_yade().utils
-        cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
-        if len(cols[0]) != self._n_existing:
-            raise GraphError("the number of bodies changed since the last full read (call invalidate())")
-        return np.column_stack([np.fromiter(c, dtype=float, count=len(c)) for c in cols])
+        return probe_replaced(self.O, self._probe)
 
     def positions(self) -> np.ndarray:
         """Current centres (n, 3) [m] of the graph's spheres (YADE's C++ bulk reader)."""
-        return self._coordinates()[self._node_slot]
+        return bulk_coordinates(self._n_existing)[self._node_slot]
 
     # -- internals -----------------------------------------------------------------------
     def _stamp_now(self):
@@ -272,51 +254,19 @@ class GranularReader:
         return None
 
     def _full_read(self):
-        yade = import_yade()
-        Sphere = yade.Sphere
-        ids, pos, rad, bodies, existing = [], [], [], [], []
-        ignored = Counter()
-        for b in self.O.bodies:
-            if b is None:
-                continue
-            existing.append(b.id)
-            if self.mask is not None and not (b.mask & self.mask):
-                ignored["masked out"] += 1
-                continue
-            if b.isClump or b.isClumpMember:
-                ignored["clump"] += 1
-                continue
-            if not isinstance(b.shape, Sphere):
-                ignored[type(b.shape).__name__] += 1
-                continue
-            p = b.state.pos
-            ids.append(b.id)
-            pos.append((p[0], p[1], p[2]))
-            rad.append(b.shape.radius)
-            bodies.append(b)
-        if not ids:
-            raise GraphError("the simulation has no spherical bodies to conduct through "
-                             f"(bodies: {len(self.O.bodies)}, left out: {dict(ignored) or 'none'}); "
-                             "add spheres, or check the mask")
-        rad = np.asarray(rad, dtype=float)
-        ids = np.asarray(ids, dtype=np.int64)
-        bad = ~(np.isfinite(rad) & (rad > 0))
-        if np.any(bad):
-            raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
-                             f"{rad[bad][:5].tolist()}")
-        slot = {bid: k for k, bid in enumerate(existing)}
-        self._slot_of = slot
-        self._node_slot = np.array([slot[int(i)] for i in ids], dtype=np.int64)
-        self._n_existing = len(existing)
+        spheres = read_spheres(self.O, self.mask)
+        ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
+        self._slot_of = spheres.slot_of
+        self._node_slot = spheres.node_slot
+        self._n_existing = len(spheres.slot_of)
         self._bodies = bodies
         self._probe = (int(ids[0]), bodies[0])
         self._stamp = self._stamp_now()
-        self.ignored = ignored
+        self.ignored = spheres.ignored
         self.full_reads += 1
         self._skin_m = self.skin * float(rad.min())
         self._revision += 1
-        self.graph = ContactGraph(np.asarray(pos, dtype=float), rad, np.zeros((0, 2), dtype=np.int64), ids,
-                                  self._revision)
+        self.graph = ContactGraph(spheres.pos, rad, np.zeros((0, 2), dtype=np.int64), ids, self._revision)
 
     def _make_lists(self, pos, geoms):
         g = self.graph

@@ -51,7 +51,7 @@ from __future__ import annotations
 import logging
 import operator
 from collections import Counter
-from typing import List, Optional
+from typing import Dict, List, NamedTuple, Optional
 
 import numpy as np
 
@@ -59,7 +59,8 @@ from ..errors import GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "write_body_attribute", "predicate_selector", "check_write_back", "BOND_CHECKS"]
+__all__ = ["SceneReader", "write_body_attribute", "predicate_selector", "check_write_back", "BOND_CHECKS",
+           "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced"]
 
 log = logging.getLogger(__name__)
 
@@ -75,6 +76,85 @@ def _bond_flag(phys):
         return lambda p: p.isCohesive and not getattr(p, "isBroken", False)
     log.debug("phys %s has no bond flag", type(phys).__name__)
     return None
+
+
+class SphereBodies(NamedTuple):
+    """The spherical bodies of a scene, read by :func:`read_spheres` (node order = body order)."""
+
+    ids: np.ndarray            # (n,) body ids
+    pos: np.ndarray            # (n, 3) centres [m]
+    radius: np.ndarray         # (n,) radii [m], finite and > 0
+    bodies: List               # the YADE bodies
+    slot_of: Dict[int, int]    # body id -> row of every existing body in YADE's bulk readers
+    node_slot: np.ndarray      # (n,) row of each sphere in the bulk readers
+    ignored: Counter           # what was left out, by reason
+
+
+def read_spheres(O, mask: Optional[int] = None) -> SphereBodies:
+    """Every body whose shape is a ``Sphere`` (not a clump or clump member, and with ``b.mask &
+    mask`` when a mask is given), by a Python loop over ``O.bodies``. GraphError when there is
+    none, or a radius is not finite and > 0."""
+    Sphere = import_yade().Sphere
+    ids, pos, rad, bodies, existing = [], [], [], [], []
+    ignored = Counter()
+    for b in O.bodies:
+        if b is None:
+            continue
+        existing.append(b.id)
+        if mask is not None and not (b.mask & mask):
+            ignored["masked out"] += 1
+            continue
+        if b.isClump or b.isClumpMember:
+            ignored["clump"] += 1
+            continue
+        if not isinstance(b.shape, Sphere):
+            ignored[type(b.shape).__name__] += 1
+            continue
+        p = b.state.pos
+        ids.append(b.id)
+        pos.append((p[0], p[1], p[2]))
+        rad.append(b.shape.radius)
+        bodies.append(b)
+    if not ids:
+        raise GraphError("the simulation has no spherical bodies to conduct through "
+                         f"(bodies: {len(O.bodies)}, left out: {dict(ignored) or 'none'}); "
+                         "add spheres, or check the mask")
+    ids = np.asarray(ids, dtype=np.int64)
+    rad = np.asarray(rad, dtype=float)
+    bad = ~(np.isfinite(rad) & (rad > 0))
+    if np.any(bad):
+        raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
+                         f"{rad[bad][:5].tolist()}")
+    slot = {bid: k for k, bid in enumerate(existing)}
+    return SphereBodies(ids, np.asarray(pos, dtype=float), rad, bodies, slot,
+                        np.array([slot[int(i)] for i in ids], dtype=np.int64), ignored)
+
+
+def bulk_coordinates(n_existing: int) -> np.ndarray:
+    """Centres (n_existing, 3) [m] of every existing body, by YADE's C++ bulk reader
+    ``utils.coordsAndDisplacements`` (rows as ``SphereBodies.slot_of``); GraphError when the
+    body count is no longer ``n_existing``."""
+    U = import_yade().utils
+    cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
+    if len(cols[0]) != n_existing:
+        raise GraphError("the number of bodies changed since the last full read (call invalidate())")
+    return np.column_stack([np.fromiter(c, dtype=float, count=len(c)) for c in cols])
+
+
+def probe_replaced(O, probe) -> bool:
+    """True when ``O`` holds another scene than the one where ``probe`` = (id, body) was read
+    (``O.load``, ``O.reset``). An erased probe (a particle that left) is not a new scene: the
+    full read its body count or volume change causes takes another probe."""
+    if probe is None:
+        return False
+    pid, body = probe
+    try:
+        if len(O.bodies) <= pid:
+            return True
+        now = O.bodies[pid]
+        return now is not None and not (now == body)
+    except Exception:
+        return True
 
 
 def _jcfpm_laws(O):
@@ -179,18 +259,7 @@ class SceneReader:
     @property
     def scene_replaced(self) -> bool:
         """True when ``O`` holds another scene than the one read (``O.load``, ``O.reset``)."""
-        if self._probe is None:
-            return False
-        pid, body = self._probe
-        try:
-            if len(self.O.bodies) <= pid:
-                return True
-            now = self.O.bodies[pid]
-            # an erased probe (a particle that left) is not a new scene: the next full read,
-            # which the body count or volume change causes, takes another probe
-            return now is not None and not (now == body)
-        except Exception:
-            return True
+        return probe_replaced(self.O, self._probe)
 
     @property
     def bond_mode(self) -> str:
@@ -239,40 +308,9 @@ class SceneReader:
         return None
 
     def _full_read(self):
-        yade = import_yade()
-        Sphere = yade.Sphere
         O = self.O
-        ids, pos, rad, bodies = [], [], [], []
-        ignored = Counter()
-        existing = []
-        for b in O.bodies:
-            if b is None:
-                continue
-            existing.append(b.id)
-            if self.mask is not None and not (b.mask & self.mask):
-                ignored["masked out"] += 1
-                continue
-            if b.isClump or b.isClumpMember:
-                ignored["clump"] += 1
-                continue
-            if not isinstance(b.shape, Sphere):
-                ignored[type(b.shape).__name__] += 1
-                continue
-            p = b.state.pos
-            ids.append(b.id)
-            pos.append((p[0], p[1], p[2]))
-            rad.append(b.shape.radius)
-            bodies.append(b)
-        if not ids:
-            raise GraphError("the simulation has no spherical bodies to conduct through "
-                             f"(bodies: {len(O.bodies)}, left out: {dict(ignored) or 'none'}); "
-                             "add spheres, or check the mask")
-        ids = np.asarray(ids, dtype=np.int64)
-        rad = np.asarray(rad, dtype=float)
-        bad = ~(np.isfinite(rad) & (rad > 0))
-        if np.any(bad):
-            raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
-                             f"{rad[bad][:5].tolist()}")
+        spheres = read_spheres(O, self.mask)
+        ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
         index = {int(i): k for k, i in enumerate(ids)}
         edges, phys, flags = [], [], []
         flag_of_type = {}
@@ -294,8 +332,8 @@ class SceneReader:
             phys.append(ph)
             flags.append(flag if self.bonds == "cohesive" else None)
         self._revision += 1
-        self.graph = ContactGraph(np.asarray(pos, dtype=float), rad,
-                                  np.asarray(edges, dtype=np.int64).reshape(-1, 2), ids, self._revision)
+        self.graph = ContactGraph(spheres.pos, rad, np.asarray(edges, dtype=np.int64).reshape(-1, 2), ids,
+                                  self._revision)
         self._bodies, self._phys, self._flags = bodies, phys, flags
         # every bond of one phys type: read its flag attribute directly
         self._uniform = None
@@ -305,13 +343,12 @@ class SceneReader:
             elif hasattr(phys[0], "isCohesive") and not hasattr(phys[0], "isBroken"):
                 self._uniform = ("isCohesive", False)
         self._sweep_at = 0
-        slot = {bid: k for k, bid in enumerate(existing)}
-        self._node_slot = np.array([slot[int(i)] for i in ids], dtype=np.int64)
-        self._n_existing = len(existing)
+        self._node_slot = spheres.node_slot
+        self._n_existing = len(spheres.slot_of)
         self._probe = (int(ids[0]), bodies[0])
         self._jcfpm = _jcfpm_laws(O)
         self._stamp = self._stamp_now()
-        self.ignored = ignored
+        self.ignored = spheres.ignored
         self.full_reads += 1
         if self.bonds == "cohesive" and not edges:
             log.warning("no cohesive bond between spheres: every element is isolated "
@@ -319,11 +356,7 @@ class SceneReader:
 
     def positions(self) -> np.ndarray:
         """Current centres (n, 3) [m] of the graph's elements, by YADE's C++ bulk reader."""
-        U = import_yade().utils
-        cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
-        if len(cols[0]) != self._n_existing:
-            raise GraphError("the number of bodies changed since the last full read (call invalidate())")
-        return np.column_stack([np.asarray(c, dtype=float)[self._node_slot] for c in cols])
+        return bulk_coordinates(self._n_existing)[self._node_slot]
 
     def _refresh_geometry(self) -> bool:
         self.geometry_reads += 1
