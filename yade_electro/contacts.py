@@ -25,8 +25,8 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["sphere_tree", "candidate_pairs", "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps",
-           "plane_contact_radius", "triangle_distance"]
+__all__ = ["sphere_tree", "candidate_pairs", "new_wall_contacts", "max_displacement", "WallGeometry",
+           "wall_candidates", "wall_overlaps", "plane_contact_radius", "triangle_distance"]
 
 
 def _ro(a):
@@ -256,3 +256,16 @@ def plane_contact_radius(radius, overlap, model: str = "geometric") -> np.ndarra
     if model == "geometric":
         return np.sqrt(np.clip(2.0 * r * dl - dl ** 2, 0.0, None))
     raise ValueError(f"contact radius model must be 'geometric' or 'hertz', got {model!r}")
+
+
+def new_wall_contacts(what: str, old, nodes, overlap):
+    """Contacts (nodes, overlaps [m]) given for a wall, checked (ValueError naming ``what``
+    unless the overlaps are finite, >= 0 and one per node); None when they equal ``old``
+    (nothing to update)."""
+    nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
+    dl = np.asarray(overlap, dtype=float).reshape(-1)
+    if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
+        raise ValueError(f"{what}: overlaps must be finite, >= 0 and one per node")
+    if old is not None and np.array_equal(nd, old[0]) and np.array_equal(dl, old[1]):
+        return None
+    return nd, dl

@@ -35,6 +35,7 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
+from .contacts import new_wall_contacts
 from .conductance import FactorNetwork, make_law
 from .electrical import ElectricalModel
 from .errors import MaterialError
@@ -269,14 +270,10 @@ class ElectroThermalModel:
         if name not in self._wall_contacts:
             from .errors import BoundaryConditionError
             raise BoundaryConditionError(f"no wall named {name!r}; have {sorted(self._wall_contacts)}")
-        nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
-        dl = np.asarray(overlap, dtype=float).reshape(-1)
-        if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
-            raise ValueError(f"wall {name!r}: overlaps must be finite, >= 0 and one per node")
-        old_nd, old_dl = self._wall_contacts[name]
-        if np.array_equal(nd, old_nd) and np.array_equal(dl, old_dl):
+        new = new_wall_contacts(f"wall {name!r}", self._wall_contacts[name], nodes, overlap)
+        if new is None:
             return                                  # the same contacts: nothing to update
-        self._wall_contacts[name] = (nd, dl)
+        self._wall_contacts[name] = new
         self._walls_applied = None
 
     def wall_conductances(self, graph: ContactGraph) -> dict:

@@ -26,6 +26,7 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
+from .contacts import new_wall_contacts
 from .conductance import ConductanceLaw, FactorNetwork, make_law
 from .errors import BoundaryConditionError
 from .graph import ContactGraph
@@ -295,14 +296,10 @@ class ElectricalModel:
         new structure."""
         if name not in self._wall_contacts:
             raise BoundaryConditionError(f"no wall electrode named {name!r}; have {self.walls}")
-        nd = np.asarray(nodes, dtype=np.int64).reshape(-1)
-        dl = np.asarray(overlap, dtype=float).reshape(-1)
-        if dl.shape != nd.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
-            raise ValueError(f"wall electrode {name!r}: overlaps must be finite, >= 0 and one per node")
-        old_nd, old_dl = self._wall_contacts[name]
-        if np.array_equal(nd, old_nd) and np.array_equal(dl, old_dl):
+        new = new_wall_contacts(f"wall electrode {name!r}", self._wall_contacts[name], nodes, overlap)
+        if new is None:
             return                                  # the same contacts: nothing to update
-        self._wall_contacts[name] = (nd, dl)
+        self._wall_contacts[name] = new
         self._walls_stale = True
 
     def _wall_factor(self, name, graph, nodes):

@@ -694,11 +694,6 @@ class HeatSolver:
         q[self.fixed] = 0.0
         self._conv_hA, self._conv_hAT = hA, hAT
         self.flux_power = _ro(q)
-        self._link_G = np.zeros(n)
-        for nd, g_link in self._links.values():
-            np.add.at(self._link_G, nd, g_link)
-        self._link_G[self.fixed] = 0.0
-        self.h_area = _ro(hA + self._link_G)
         self._refresh_links()
         self.nodes_of = {**self._fixed_nodes, **{k: v[0] for k, v in self._links.items()},
                          **{b.name: nodes(b) for b in self.flux_bcs + self.convection_bcs}}
@@ -823,11 +818,6 @@ class HeatSolver:
         g = np.where(self.fixed[nd], 0.0, g)
         self._links[name] = (nd, g)
         self.nodes_of[name] = nd
-        link_G = np.zeros(self.n)
-        for k, (nk, gk) in self._links.items():
-            np.add.at(link_G, nk, gk)
-        self._link_G = link_G
-        self.h_area = _ro(self._conv_hA + link_G)
         self._refresh_links()
         if assemble:
             self._assemble()
@@ -849,12 +839,16 @@ class HeatSolver:
             T[nodes] = self._fixed_value[name]
 
     def _refresh_links(self):
-        """Right-hand side of the surface temperatures: sum G_i T_s on each node."""
-        GT = np.zeros(self.n)
+        """What the linked fixed temperatures add on each node: the diagonal sum G_i (into
+        ``h_area``) and the right-hand side sum G_i T_s (fixed nodes take neither)."""
+        G, GT = np.zeros(self.n), np.zeros(self.n)
         for name, (nd, g_link) in self._links.items():
+            np.add.at(G, nd, g_link)
             np.add.at(GT, nd, g_link * self._fixed_value[name])
+        G[self.fixed] = 0.0
         GT[self.fixed] = 0.0
-        self._link_GT = GT
+        self._link_G, self._link_GT = G, GT
+        self.h_area = _ro(self._conv_hA + G)
         self._hAT = self._conv_hAT + GT
 
     def _fixed_group_values(self):
