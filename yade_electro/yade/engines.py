@@ -92,7 +92,7 @@ class _Engine:
         if opts["bonds"] == "contacts":
             self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls)
         else:
-            if walls:
+            if self._declared_walls:
                 raise BoundaryConditionError("walls (walls=, or electrodes with wall=) conduct in the granular mode "
                                              "only (bonds='contacts'): a bonded solid's boundaries are surfaces "
                                              "(surface=)")
@@ -287,6 +287,7 @@ class ElectricalEngine(_Engine):
                               skin=skin, walls=_electrode_walls(electrodes) or None)
         self._options_bonds = bonds
         self._electrode_walls = _electrode_walls(electrodes)
+        self._declared_walls = list(self._electrode_walls)
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
@@ -341,11 +342,7 @@ class ElectricalEngine(_Engine):
             if unknown:
                 raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select=, "
                                              "surface= or wall=, and potential= (V) or current= (A)")
-            if spec.get("wall") is not None:
-                if self._options_bonds != "contacts":
-                    raise BoundaryConditionError(f"electrode {name!r}: wall= electrodes are walls of a granular bed "
-                                                 "(bonds='contacts'); a bonded solid's electrodes are surfaces "
-                                                 "(surface=) or element layers (select=)")
+            if spec.get("wall") is not None:           # granular mode only: checked in _start
                 check_wall_bodies(self.O, name, spec["wall"])
                 spec["wall"] = True
             specs.append(ElectrodeSpec(name, **spec))
@@ -560,11 +557,9 @@ class ElectroThermalEngine(ElectricalEngine):
         self._options_bonds = bonds
         self._walls = {w.name: dict(bodies=list(ids), temperature=w.temperature, conductivity=w.conductivity)
                        for w, ids in wall_specs}
+        self._declared_walls = list(self._electrode_walls) + list(self._walls)     # adiabatic ones too
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
                     write_back if electrodes is not None else None, plot)
-        if wall_specs and bonds != "contacts":
-            raise BoundaryConditionError("walls= conduct in the granular mode only (bonds='contacts'): a bonded "
-                                         "solid's boundaries are surfaces (fixed=[FixedTemperature(..., surface=...)])")
         for w, ids in wall_specs:
             check_wall_bodies(self.O, w.name, ids)
         law, law_params = self._law_and_container(law, law_params, container)
