@@ -69,3 +69,18 @@ def sweep_runs(run_one, sizes, laws, out_dir, csv_name, fields, summary_line):
                 fh.flush()
                 print(summary_line(row), flush=True)
     return rows
+
+
+def frictional_bed(O, wall_shapes=(), gravity=(0, 0, -9.81), damping=0.2):
+    """Give YADE's ``O`` the engines of a cohesionless frictional bed (``FrictMat`` with
+    Cundall-Strack contacts) among walls of ``wall_shapes`` ('Facet', 'Wall'), and a time step
+    of half the P-wave step. The granular cases share it."""
+    from yade import utils
+    from yade import wrapper as W
+    bounds = [W.Bo1_Sphere_Aabb()] + [getattr(W, f"Bo1_{k}_Aabb")() for k in wall_shapes]
+    geoms = [W.Ig2_Sphere_Sphere_ScGeom()] + [getattr(W, f"Ig2_{k}_Sphere_ScGeom")() for k in wall_shapes]
+    O.engines = [W.ForceResetter(), W.InsertionSortCollider(bounds),
+                 W.InteractionLoop(geoms, [W.Ip2_FrictMat_FrictMat_FrictPhys()],
+                                   [W.Law2_ScGeom_FrictPhys_CundallStrack()]),
+                 W.NewtonIntegrator(gravity=gravity, damping=damping)]
+    O.dt = 0.5 * utils.PWaveTimeStep()

@@ -79,14 +79,8 @@ def fill_container(n=2000, seed=1, settle=1.0, verbose=True):
     kept = [(c, rad) for c, rad in sp if c[0] ** 2 + c[1] ** 2 < box ** 2]
     kept.sort(key=lambda cr: cr[0][2])
     spheres = O.bodies.append([utils.sphere(c, rad, material=mat) for c, rad in kept[:n]])
-    O.engines = [
-        W.ForceResetter(),
-        W.InsertionSortCollider([W.Bo1_Sphere_Aabb(), W.Bo1_Facet_Aabb()]),
-        W.InteractionLoop([W.Ig2_Sphere_Sphere_ScGeom(), W.Ig2_Facet_Sphere_ScGeom()],
-                          [W.Ip2_FrictMat_FrictMat_FrictPhys()], [W.Law2_ScGeom_FrictPhys_CundallStrack()]),
-        W.NewtonIntegrator(gravity=(0, 0, -9.81), damping=0.3),
-    ]
-    O.dt = 0.5 * utils.PWaveTimeStep()
+    from caselib import frictional_bed
+    frictional_bed(O, ("Facet",), gravity=(0, 0, -9.81), damping=0.3)
     chunk = max(int(0.02 / O.dt), 1)
     peak, t = 0.0, time.time()
     while O.time < settle:

@@ -82,14 +82,8 @@ def build(n=2000, seed=1):
     sp.makeCloud((-h + 1.2 * r, -h + 1.2 * r, 10e-3), (h - 1.2 * r, h - 1.2 * r, 10e-3 + height), rMean=r,
                  rRelFuzz=0.2, num=n, seed=seed)
     spheres = O.bodies.append([utils.sphere(c, rad, material=mat) for c, rad in sp])
-    O.engines = [
-        W.ForceResetter(),
-        W.InsertionSortCollider([W.Bo1_Sphere_Aabb(), W.Bo1_Wall_Aabb()]),
-        W.InteractionLoop([W.Ig2_Sphere_Sphere_ScGeom(), W.Ig2_Wall_Sphere_ScGeom()],
-                          [W.Ip2_FrictMat_FrictMat_FrictPhys()], [W.Law2_ScGeom_FrictPhys_CundallStrack()]),
-        W.NewtonIntegrator(gravity=(0, 0, -9.81), damping=0.2),
-    ]
-    O.dt = 0.5 * utils.PWaveTimeStep()
+    from caselib import frictional_bed
+    frictional_bed(O, ("Wall",), gravity=(0, 0, -9.81), damping=0.2)
     return {"spheres": list(spheres), "floor": floor, "sides": list(sides), "width": width, "material": mat}
 
 

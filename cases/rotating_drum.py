@@ -119,14 +119,8 @@ def build_drum(n=2000, seed=1, baffles=False, settle_time=0.4, verbose=True):
     sp.makeCloud((-box, -box, -L / 2 + r), (box, box, L / 2 - r), rMean=r, rRelFuzz=0.0, num=n_cloud, seed=seed)
     kept = [(c, rad) for c, rad in sp if c[0] ** 2 + c[1] ** 2 < (R - 1.5 * r) ** 2]
     spheres = O.bodies.append([utils.sphere(c, rad, material=mat) for c, rad in kept])
-    O.engines = [
-        W.ForceResetter(),
-        W.InsertionSortCollider([W.Bo1_Sphere_Aabb(), W.Bo1_Facet_Aabb(), W.Bo1_Wall_Aabb()]),
-        W.InteractionLoop([W.Ig2_Sphere_Sphere_ScGeom(), W.Ig2_Facet_Sphere_ScGeom(), W.Ig2_Wall_Sphere_ScGeom()],
-                          [W.Ip2_FrictMat_FrictMat_FrictPhys()], [W.Law2_ScGeom_FrictPhys_CundallStrack()]),
-        W.NewtonIntegrator(gravity=(0, -9.81, 0), damping=0.1),
-    ]
-    O.dt = 0.5 * utils.PWaveTimeStep()
+    from caselib import frictional_bed
+    frictional_bed(O, ("Facet", "Wall"), gravity=(0, -9.81, 0), damping=0.1)
     steps = int(settle_time / O.dt)
     t = time.time()
     done = 0
