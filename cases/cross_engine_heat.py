@@ -5,6 +5,9 @@ Two problems, both on particles that do not move (the contacts are fixed):
 
 * ``two_spheres``: two copper spheres, r = 2 mm, centres 3.8 mm apart, 100 / 0 degC (the
   problem of cases/two_spheres.py), 0.2 s;
+* ``floor``: the same packing, every particle at 0 degC, on an isothermal floor at 100 degC
+  (LIGGGHTS' ``zplane`` wall with ``temperature``, YADE's ``Wall`` in ``walls=``), 1 s; the
+  heat the particles stored is compared too;
 * ``packing``: about 2,000 copper spheres (radii 0.9 and 1.1 mm, equal mass fractions) settled
   under gravity in a cylinder of radius 10 mm by LIGGGHTS (``settle`` template, soft
   Y = 5 MPa as LIGGGHTS users take it, so overlaps are about 1 % of r), then frozen; the
@@ -51,7 +54,7 @@ for _p in (os.path.dirname(HERE), HERE):
 
 T_HOT, T_COLD = 373.15, 273.15      # K
 COPPER = dict(conductivity=385.0, density=8900.0, specific_heat=172.0)   # paper 002 table III.1
-PROBLEMS = ("two_spheres", "packing")
+PROBLEMS = ("two_spheres", "packing", "floor")
 
 
 def copper(young=110e9):
@@ -84,16 +87,18 @@ def settled_particles(n=2000, workdir="out/cross_engine_heat/settle", radius=0.0
     return data, {int(i): T_HOT for i in hot}, mat, p
 
 
-def liggghts_run(data, init, mat, timestep, steps, dump_every, workdir):
-    from yade_electro.liggghts import heat_conduction_deck, run_heat_conduction
-    deck = heat_conduction_deck(data, [mat], T_COLD, timestep, steps, dump_every, initial_temperature=init)
+def liggghts_run(data, init, mat, timestep, steps, dump_every, workdir, floor=False):
+    from yade_electro.liggghts import PlaneWall, heat_conduction_deck, run_heat_conduction
+    walls = [PlaneWall("z", 0.0, temperature=T_HOT)] if floor else []
+    deck = heat_conduction_deck(data, [mat], T_COLD, timestep, steps, dump_every, initial_temperature=init, walls=walls)
     return run_heat_conduction(deck, workdir)
 
 
-def yade_run(data, init, mat, times, law, calls_per_dump=100):
+def yade_run(data, init, mat, times, law, calls_per_dump=100, floor=False):
     """Temperatures [K] (len(times), n) of the particles (data order) in YADE with the heat
     engine at the sample ``times`` [s] (equally spaced from 0), and the engine's contacts at
-    the end: {(atom id 1, atom id 2): G [W/K]}."""
+    the end: {(atom id 1, atom id 2): G [W/K]}, and the heat the isothermal ``floor`` (a
+    YADE ``Wall`` at z = 0, T_HOT) gave [J] (None without it)."""
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()
     from yade import wrapper as W
@@ -104,12 +109,17 @@ def yade_run(data, init, mat, times, law, calls_per_dump=100):
     ymat = W.FrictMat(young=mat.young, poisson=mat.poisson, density=mat.density, frictionAngle=math.atan(mat.friction))
     ids = add_spheres(data.positions, data.radius, ymat, fixed=True, O=O)
     body_of_atom = dict(zip(data.ids.tolist(), ids))
+    walls = None
+    if floor:
+        from yade import utils
+        wall = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=ymat))
+        walls = {"floor": dict(bodies=wall, temperature=T_HOT)}
     O.dt = 1e-6                        # nothing moves: the engine alone runs
     interval = float(times[1] - times[0])
     engine = HeatEngine(mat.density, mat.specific_heat, mat.conductivity, T_COLD,
                         initial_temperature={body_of_atom[a]: T for a, T in init.items()}, law=law,
                         bonds="contacts", theta="crank-nicolson", thermal_dt=interval / calls_per_dump,
-                        label=f"cross_{law}", O=O)
+                        walls=walls, label=f"cross_{law}", O=O)
     O.engines = [engine.runner]
     out = []
     order = np.array(ids)
@@ -120,13 +130,14 @@ def yade_run(data, init, mat, times, law, calls_per_dump=100):
         out.append([T[int(i)] for i in order])
     t_engine = engine.coupled.time
     pairs, G, _ = engine.contact_heat_flow()
+    wall_heat = engine.wall_heat()["floor"] if floor else None
     atom_of_body = {b: a for a, b in body_of_atom.items()}
     contacts = {tuple(sorted((atom_of_body[int(i)], atom_of_body[int(j)]))): float(g)
                 for (i, j), g in zip(pairs.tolist(), G.tolist())}
     engine.remove()
     if not math.isclose(t_engine, times[-1], rel_tol=1e-9):
         raise RuntimeError(f"the engine's clock reached {t_engine} s, not {times[-1]} s")
-    return np.asarray(out), contacts
+    return np.asarray(out), contacts, wall_heat
 
 
 def contact_agreement(lig_contacts, yade_contacts, conductivity):
@@ -148,22 +159,27 @@ def decay_time(t, T1, T2):
     return float(-1.0 / np.polyfit(np.asarray(t)[ok], np.log(d[ok]), 1)[0])
 
 
-def compare(problem, out_dir, n=2000, calls_per_dump=100):
+def compare(problem, out_dir, n=2000, calls_per_dump=100, _settled={}):
     """Run ``problem`` in both engines; returns its figures and curves."""
     work = os.path.join(out_dir, problem)
+    floor = problem == "floor"
     if problem == "two_spheres":
         data, init, mat = two_sphere_particles()
         timestep, steps, dump_every, extra = 1e-5, 20000, 2000, {}
     else:
-        data, init, mat, settled = settled_particles(n, os.path.join(out_dir, "settle"))
+        if n not in _settled:               # the packing and floor problems share one packing
+            _settled[n] = settled_particles(n, os.path.join(out_dir, "settle"))
+        data, init, mat, settled = _settled[n]
+        if floor:
+            init = {}                       # every particle cold, the floor hot
         timestep, steps, dump_every = 1e-4, 10000, 500
         extra = {"n": data.n, "settled": bool(settled.settled), "settle_time_s": settled.time,
                  "settle_ke_per_particle_J": settled.ke_per_particle, "settle_wall_s": settled.run.elapsed_s}
-    lig = liggghts_run(data, init, mat, timestep, steps, dump_every, work)
+    lig = liggghts_run(data, init, mat, timestep, steps, dump_every, work, floor)
     table = lig.temperature_table()
     times = table.index.to_numpy()
     T_lig = table[data.ids.tolist()].to_numpy()
-    T_yade, yade_contacts = yade_run(data, init, mat, times, "liggghts", calls_per_dump)
+    T_yade, yade_contacts, wall_heat = yade_run(data, init, mat, times, "liggghts", calls_per_dump, floor)
     diff = 100.0 * np.max(np.abs(T_yade - T_lig), axis=1) / (T_HOT - T_COLD)
     contacts0 = lig.contacts[min(lig.contacts)]
     row = {"problem": problem, "n": data.n, "max_rel_diff_pct": float(diff.max()),
@@ -173,7 +189,7 @@ def compare(problem, out_dir, n=2000, calls_per_dump=100):
            **contact_agreement(lig.contacts[max(lig.contacts)], yade_contacts, mat.conductivity), **extra}
     curves = {"t": times, "diff": diff}
     if problem == "two_spheres":
-        T_contact, _ = yade_run(data, init, mat, times, "contact", calls_per_dump)
+        T_contact, _, _ = yade_run(data, init, mat, times, "contact", calls_per_dump)
         tau = {"liggghts_engine": decay_time(times, T_lig[:, 0], T_lig[:, 1]),
                "yade_liggghts_law": decay_time(times, T_yade[:, 0], T_yade[:, 1]),
                "yade_contact_law": decay_time(times, T_contact[:, 0], T_contact[:, 1])}
@@ -185,6 +201,17 @@ def compare(problem, out_dir, n=2000, calls_per_dump=100):
                     "T_final_liggghts": T_lig[-1].tolist(), "T_final_yade": T_yade[-1].tolist()})
         row["h_c_ratio"] = row["h_c_liggghts_W_per_K"] / row["h_c_2ka_W_per_K"]
         curves.update(T_lig=T_lig, T_yade=T_yade, T_contact=T_contact)
+    elif floor:
+        C = data.mass * mat.specific_heat
+        stored_lig = float(np.sum(C * (T_lig[-1] - T_COLD)))
+        stored_yade = float(np.sum(C * (T_yade[-1] - T_COLD)))
+        floor_contacts = int(np.sum(data.positions[:, 2] < data.radius))
+        row.update({"floor_contacts": floor_contacts, "heat_stored_liggghts_J": stored_lig,
+                    "heat_stored_yade_J": stored_yade, "wall_heat_yade_J": wall_heat,
+                    "heat_rel_diff": stored_yade / stored_lig - 1.0})
+        low = data.positions[:, 2] < 3 * data.radius.max()
+        curves.update(mean_low_lig=T_lig[:, low].mean(axis=1), mean_low_yade=T_yade[:, low].mean(axis=1),
+                      mean_lig=T_lig.mean(axis=1), mean_yade=T_yade.mean(axis=1))
     else:
         hot = np.isin(data.ids, list(init))
         curves.update(mean_hot_lig=T_lig[:, hot].mean(axis=1), mean_hot_yade=T_yade[:, hot].mean(axis=1),
@@ -213,6 +240,12 @@ def plot(curves, path):
                 ax.plot(t, c["T_yade"][:, j] - 273.15, "b.-", label="YADE, liggghts law" if j == 0 else None)
                 ax.plot(t, c["T_contact"][:, j] - 273.15, "g--", label="YADE, contact law (2ka)" if j == 0 else None)
             ax.set_title("two copper spheres: h_c ratio sqrt(pi)")
+        elif name == "floor":
+            ax.plot(t, c["mean_low_lig"] - 273.15, "ks", ms=4, mfc="none", label="LIGGGHTS")
+            ax.plot(t, c["mean_low_yade"] - 273.15, "b.-", label="YADE: spheres within 3 r of the floor")
+            ax.plot(t, c["mean_lig"] - 273.15, "ks", ms=4, mfc="none")
+            ax.plot(t, c["mean_yade"] - 273.15, "g.-", label="YADE: all")
+            ax.set_title("packing on a floor at 100 degC")
         else:
             ax.plot(t, c["mean_hot_lig"] - 273.15, "ks", ms=4, mfc="none", label="LIGGGHTS")
             ax.plot(t, c["mean_hot_yade"] - 273.15, "b.-", label="YADE")
@@ -245,6 +278,9 @@ def main(argv=None):
               f"{r['max_rel_diff_pct']:.2e} % of the range over {r['dumps']} dumps; contacts in one engine only: "
               f"{r['contacts_liggghts_only']} / {r['contacts_yade_only']}, conductances differ by at most "
               f"{r['conductance_max_rel_diff']:.1e}", flush=True)
+        if problem == "floor":
+            print(f"  {r['floor_contacts']} floor contacts; heat stored {r['heat_stored_liggghts_J']:.4f} J (LIGGGHTS), "
+                  f"{r['heat_stored_yade_J']:.4f} J (YADE; its floor gave {r['wall_heat_yade_J']:.4f} J)", flush=True)
         if problem == "two_spheres":
             print(f"  h_c LIGGGHTS / 2ka = {r['h_c_ratio']:.5f}, tau(contact law) / tau(LIGGGHTS) = "
                   f"{r['tau_ratio_contact_over_liggghts']:.5f}; sqrt(pi) = {math.sqrt(math.pi):.5f}", flush=True)

@@ -1,7 +1,7 @@
-"""cases/cross_engine_heat.py on the real YADE and LIGGGHTS: the two spheres and a small
-settled packing agree particle by particle at every dump (< 0.5 % of the range; measured
-3e-3 % and 3e-2 % at full size), the same contacts with the same conductances, and the
-contact law's decay time is sqrt(pi) times LIGGGHTS'."""
+"""cases/cross_engine_heat.py on the real YADE and LIGGGHTS: the two spheres, a small settled
+packing and the same packing on an isothermal floor agree particle by particle at every dump
+(< 0.5 % of the range), with the same contacts and conductances; the floor's heat is what the
+particles stored; the contact law's decay time is sqrt(pi) times LIGGGHTS'."""
 import math
 import os
 
@@ -12,7 +12,7 @@ CASE = os.path.join(ROOT, "cases", "cross_engine_heat.py")
 def test_cross_engine_heat_small(run_yade_script, liggghts_exe, tmp_path):
     res = run_yade_script(CASE, "--n", "300", "--out", str(tmp_path), timeout=900, check=True)
     row = res.result
-    assert row["case"] == "cross_engine_heat" and row["problem"] == "two_spheres,packing"
+    assert row["case"] == "cross_engine_heat" and row["problem"] == "two_spheres,packing,floor"
     assert row["max_rel_diff_pct"] < 0.5
     for name, p in row["problems"].items():
         assert p["max_rel_diff_pct"] < 0.5 and len(p["rel_diff_pct_per_dump"]) == p["dumps"] > 5, name
@@ -23,4 +23,7 @@ def test_cross_engine_heat_small(run_yade_script, liggghts_exe, tmp_path):
     assert abs(two["tau_ratio_contact_over_liggghts"] / math.sqrt(math.pi) - 1) < 1e-3
     pack = row["problems"]["packing"]
     assert pack["n"] == 300 and pack["settled"] and pack["liggghts_contacts"] > 300
+    floor = row["problems"]["floor"]
+    assert floor["floor_contacts"] > 20 and abs(floor["heat_rel_diff"]) < 5e-3
+    assert abs(floor["wall_heat_yade_J"] / floor["heat_stored_yade_J"] - 1) < 1e-9     # all of it from the floor
     assert os.path.exists(row["png"])

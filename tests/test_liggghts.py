@@ -142,3 +142,56 @@ def test_settle_a_packing_in_a_cylinder(liggghts_exe, tmp_path):
     rho_xy = np.hypot(p.centers[:, 0], p.centers[:, 1])
     assert np.all(rho_xy + p.radii <= R * 1.01) and np.all(p.centers[:, 2] - p.radii >= -0.01 * p.radii)
     assert p.centers[:, 2].max() < 0.02          # fell to the bottom from up to 35 mm
+
+
+PLATE_STL = """solid plate
+facet normal 0 0 1
+outer loop
+vertex -0.01 -0.01 0
+vertex 0.01 -0.01 0
+vertex 0.01 0.01 0
+endloop
+endfacet
+facet normal 0 0 1
+outer loop
+vertex -0.01 -0.01 0
+vertex 0.01 0.01 0
+vertex -0.01 0.01 0
+endloop
+endfacet
+endsolid plate
+"""
+
+
+def test_isothermal_plane_mesh_and_moving_particles(liggghts_exe, tmp_path):
+    """A sphere on an isothermal floor warms as T_w - 100 K exp(-h t / C) per explicit step,
+    h = 2 sqrt(pi) k a with a^2 = 2 r delta - delta^2; an STL floor gives the same numbers as
+    the primitive plane; a soft sphere resting on the floor under gravity (moving particles,
+    ``integrate``) warms as the same sphere held in place."""
+    (tmp_path / "plate.stl").write_text(PLATE_STL)
+    box = [[-0.01, 0.01]] * 2 + [[-0.005, 0.01]]
+    d = L.particle_data([[0, 0, 1.9e-3]], 2e-3, 8900.0, box=box)
+    out = {}
+    for name, wall in (("plane", L.PlaneWall("z", 0.0, temperature=373.15)),
+                       ("mesh", L.MeshWall(str(tmp_path / "plate.stl"), temperature=373.15))):
+        deck = L.heat_conduction_deck(d, [COPPER], 273.15, 1e-6, 2000, 1000, walls=[wall])
+        out[name] = L.run_heat_conduction(deck, tmp_path / name, exe=liggghts_exe, progress=None).temperature_table()
+    soft = L.GranularMaterial(young=5e6, poisson=0.34, density=8900.0, conductivity=385.0, specific_heat=172.0)
+    y_star = 5e6 / (2 * (1 - 0.34 ** 2))                   # sphere on a wall of the same material
+    weight = 8900.0 * 4.0 / 3.0 * math.pi * 2e-3 ** 3 * 9.81
+    delta_eq = (3 * weight / (4 * y_star * math.sqrt(2e-3))) ** (2 / 3)     # Hertz: F = 4/3 Y* sqrt(r) delta^1.5
+    rest = L.particle_data([[0, 0, 2e-3 - delta_eq]], 2e-3, 8900.0, box=box)
+    for name, integrate in (("held", False), ("resting", True)):
+        deck = L.heat_conduction_deck(rest, [soft], 273.15, 1e-5, 20000, 5000, integrate=integrate, gravity=integrate,
+                                      walls=[L.PlaneWall("z", 0.0, temperature=373.15)])
+        out[name] = L.run_heat_conduction(deck, tmp_path / name, exe=liggghts_exe, progress=None).temperature_table()
+    dl = 1e-4
+    h = 2.0 * math.sqrt(math.pi) * 385.0 * math.sqrt(2 * 2e-3 * dl - dl * dl)
+    C = 8900.0 * 172.0 * 4.0 / 3.0 * math.pi * 2e-3 ** 3
+    for t, T in out["plane"][1].items():
+        assert 373.15 - T == pytest.approx(100.0 * (1.0 - 1e-6 * h / C) ** round(t / 1e-6), rel=1e-9)
+    np.testing.assert_allclose(out["mesh"].to_numpy(), out["plane"].to_numpy(), rtol=1e-12)
+    assert out["held"][1].iloc[-1] > 280.0                  # it warms noticeably
+    np.testing.assert_allclose(out["resting"].to_numpy(), out["held"].to_numpy(), rtol=1e-6)
+    with pytest.raises(FileNotFoundError, match="STL"):
+        L.wall_commands([L.MeshWall(str(tmp_path / "none.stl"))])

@@ -88,7 +88,8 @@ def _scan(path: Path):
 
 
 def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_name: str = "in.liggghts",
-             progress: Optional[float] = 10.0, total_steps: Optional[int] = None) -> LiggghtsRun:
+             progress: Optional[float] = 10.0, total_steps: Optional[int] = None,
+             total_is_bound: bool = False) -> LiggghtsRun:
     """Write ``deck`` (the text of an input deck) and ``files`` (name -> text) into
     ``workdir`` and run LIGGGHTS on it there.
 
@@ -108,7 +109,8 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     progress : float or None
         Print LIGGGHTS' last thermo line every ``progress`` seconds of a long run (None: quiet).
     total_steps : int, optional
-        With ``progress``: the steps expected, for an estimate of the time left.
+        With ``progress``: the steps expected, for an estimate of the time left;
+        ``total_is_bound``: they are at most (a run that may stop early, as settling does).
 
     Raises
     ------
@@ -151,7 +153,7 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
             if progress and now - last_print >= progress:
                 last_print = now
                 _, _, thermo = _scan(out)
-                _print_progress(thermo, now - t0, total_steps)
+                _print_progress(thermo, now - t0, total_steps, total_is_bound)
     elapsed = time.perf_counter() - t0
     error, warnings, thermo = _scan(out)
     if error is None:
@@ -165,12 +167,13 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
                        warnings=tuple(warnings), last_thermo=thermo)
 
 
-def _print_progress(thermo, elapsed, total_steps):
+def _print_progress(thermo, elapsed, total_steps, total_is_bound=False):
     msg = f"[liggghts] {elapsed:6.0f} s"
     if thermo:
         msg += f", step {thermo.split()[0]}"
         if total_steps:
             step = int(thermo.split()[0])
             if 0 < step < total_steps:
-                msg += f" of {total_steps}, about {elapsed * (total_steps - step) / step:.0f} s left"
+                most = "at most " if total_is_bound else ""
+                msg += f" of {most}{total_steps}, {most}about {elapsed * (total_steps - step) / step:.0f} s left"
     print(msg, file=sys.stderr, flush=True)

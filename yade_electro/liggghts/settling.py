@@ -122,7 +122,7 @@ def settle_packing(walls, region, n_particles: int, radii, mass_fractions, mater
     deck = settle_deck(walls, region, n_particles, radii, mass_fractions, material, box, timestep,
                        settle_time=settle_time, **deck_options)
     total = int(round(settle_time / timestep)) + int(round(deck_options.get("insert_time", 0.1) / timestep))
-    run = run_deck(deck, workdir, exe=exe, timeout=timeout, progress=progress, total_steps=total)
+    run = run_deck(deck, workdir, exe=exe, timeout=timeout, progress=progress, total_steps=total, total_is_bound=True)
     frame = read_dump_frames(run.workdir / "settled.dump")[-1]
     df = frame.data
     m = re.search(r"YADE_ELECTRO_END step (\d+) ke_per_particle (\S+)", run.text())

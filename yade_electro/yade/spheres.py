@@ -56,9 +56,10 @@ def add_spheres(centers, radii, material=None, fixed: bool = False, color=None, 
         raise ValueError("centres must be finite and radii finite and > 0 (m)")
     kw = {}
     if material is not None:
-        if not isinstance(material, (int, str)) and material not in list(O.materials):
-            O.materials.append(material)
-        kw["material"] = material
+        if isinstance(material, (int, str)):
+            kw["material"] = O.materials[material].id
+        else:
+            kw["material"] = material.id if material.id >= 0 else O.materials.append(material)
     if color is not None:
         kw["color"] = color
     ids = O.bodies.append([utils.sphere(tuple(p), float(rr), **kw) for p, rr in zip(c.tolist(), r.tolist())])
