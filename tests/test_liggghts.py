@@ -195,3 +195,17 @@ def test_isothermal_plane_mesh_and_moving_particles(liggghts_exe, tmp_path):
     np.testing.assert_allclose(out["resting"].to_numpy(), out["held"].to_numpy(), rtol=1e-6)
     with pytest.raises(FileNotFoundError, match="STL"):
         L.wall_commands([L.MeshWall(str(tmp_path / "none.stl"))])
+
+
+def test_settle_on_an_stl_floor(liggghts_exe, tmp_path):
+    """The container may be an STL mesh: spheres settled on a triangulated floor rest on it."""
+    (tmp_path / "plate.stl").write_text(PLATE_STL)
+    R = 0.006
+    mat = L.GranularMaterial(young=5e6, poisson=0.3, density=2500.0)
+    walls = [L.CylinderWall("z", R), L.MeshWall(str(tmp_path / "plate.stl"))]
+    box = [[-R - 1e-3, R + 1e-3]] * 2 + [[-1e-3, 0.03]]
+    p = L.settle_packing(walls, L.CylinderRegion(R - 1e-3, 1e-3, 0.025), 60, [0.7e-3], [1.0], mat, box, 2e-5,
+                         tmp_path / "run", settle_time=1.0, exe=liggghts_exe, progress=None)
+    assert p.n == 60 and p.settled
+    bottom = p.centers[:, 2] - p.radii
+    assert bottom.min() > -0.02 * 0.7e-3 and np.sum(bottom < 0.05 * 0.7e-3) >= 10     # resting on the mesh
