@@ -19,12 +19,14 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PY="${PY:-/usr/bin/python3}"
 
 # Debian packages. python3-setuptools/-wheel: the editable install builds with them
-# (--no-build-isolation, so pip fetches no setuptools from PyPI).
+# (--no-build-isolation, so pip fetches no setuptools from PyPI). g++ and libeigen3-dev:
+# bench/bench_scale.py builds an Eigen ConjugateGradient driver to compare the solves with.
 DEB_PACKAGES=(
   yade liggghts
   python3-pip python3-setuptools python3-wheel
   python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest python3-meshio
   gmsh python3-gmsh
+  g++ libeigen3-dev
 )
 
 # PyPI packages Debian 12 lacks, pinned to the newest release that declares support for

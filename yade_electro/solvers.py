@@ -36,6 +36,10 @@ Solvers
 Tolerance: CG stops at ``||A x - b|| <= max(rtol ||b||, atol)`` (default rtol 1e-10, atol 0;
 ``solve(A, b, x0, atol=...)`` sets a floor for right-hand sides at rounding level) and raises
 :class:`~yade_electro.errors.SolverError` if it cannot get there.
+
+Threads: importing this module holds OpenBLAS to ``YADE_ELECTRO_BLAS_THREADS`` threads
+(default 1, as inside YADE; 0 leaves it alone): see :mod:`yade_electro.threads` and
+``bench/bench_threads.py``.
 """
 from __future__ import annotations
 
@@ -49,6 +53,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .errors import SolverError
+from .threads import apply_default_limit
+
+# OpenBLAS to one thread (YADE_ELECTRO_BLAS_THREADS, default 1): see yade_electro.threads
+apply_default_limit()
 
 __all__ = ["make_solver", "solver_names", "auto_solver_name", "CGSolver", "DeflatedCGSolver", "AMGSolver",
            "DirectSolver", "AUTO_DEFLATION_FROM"]

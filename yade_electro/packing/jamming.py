@@ -7,6 +7,9 @@ Everything here works in units of a reference radius ``r0`` (positions ``x``, ra
 from __future__ import annotations
 
 import logging
+import math
+import sys
+import time
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -14,6 +17,9 @@ from scipy.spatial import cKDTree
 __all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps"]
 
 log = logging.getLogger(__name__)
+
+#: seconds between two progress lines of a long jamming run
+PROGRESS_EVERY = 10.0
 
 
 class Relaxer:
@@ -143,7 +149,8 @@ def random_inside(shape, rad, r0, rng, max_rounds=200):
 
 
 def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume):
-    """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``)."""
+    """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``). A run
+    longer than :data:`PROGRESS_EVERY` seconds prints a progress line that often."""
     phi_nom = float(np.sum(4 / 3 * np.pi * (rho * r0) ** 3)) / volume  # fraction at s = 1
     s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
     rel = Relaxer(shape, rho, r0, skin=skin)
@@ -155,7 +162,15 @@ def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, s
                            f"(fraction {phi_start}); max overlap {ov:.3g} r_mean")
     x_ok, s_ok, ds = x, s, ds0
     trials = 0
+    t0 = last = time.perf_counter()
     while ds >= ds_min and s_ok < s_max:
+        now = time.perf_counter()
+        if now - last >= PROGRESS_EVERY:     # long work shows progress (stderr)
+            last = now
+            left = max(0.0, math.log2(ds / ds_min)) + 1.0
+            print(f"[packing] {x.shape[0]} spheres: volume fraction {phi_nom * s_ok ** 3:.4f}, growth step {ds:.2g} "
+                  f"(stops below {ds_min:g}: at least {left:.0f} more trials of about {(now - t0) / max(trials, 1):.0f} s, "
+                  f"{trials} done in {now - t0:.0f} s)", file=sys.stderr, flush=True)
         s_try = min(s_max, s_ok * (1 + ds))
         x_try, ov, status, steps = rel.minimise(x_ok, s_try, tol, max_steps)
         total += steps
