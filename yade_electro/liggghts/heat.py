@@ -15,7 +15,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Dict, Optional, Sequence
 
-
 from .datafile import ParticleData, format_data
 from .deck import GranularMaterial, material_commands, pair_local_columns, render_deck, temperature_commands, \
     wall_commands
@@ -88,6 +87,8 @@ def heat_conduction_deck(data: ParticleData, materials: Sequence[GranularMateria
         raise ValueError(f"steps and dump_every must be >= 1, got {steps}, {dump_every}")
     if not timestep > 0:
         raise ValueError(f"timestep must be > 0 (s), got {timestep!r}")
+    if not (float(temperature) > 0 and float(temperature) < float("inf")):
+        raise ValueError(f"temperature must be finite and > 0 (K), got {temperature!r}")
     if contact_model not in ("hertz", "hooke"):
         raise ValueError(f"contact_model must be 'hertz' or 'hooke', got {contact_model!r}")
     init = dict(initial_temperature or {})
