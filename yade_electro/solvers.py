@@ -298,8 +298,13 @@ class DeflatedCGSolver(CGSolver):
         if not h or not np.isfinite(h) or h <= 0:
             h = float(np.prod(np.maximum(hi - lo, 1e-300))) ** (1 / 3) / max(n, 1) ** (1 / 3)
         cell = np.floor((X - lo) / (self.cluster_size * h)).astype(np.int64)
-        _, lab = np.unique(cell, axis=0, return_inverse=True)
-        return lab.reshape(-1), int(lab.max()) + 1
+        # the cells numbered in lexicographic (x, y, z) order, as np.unique(cell, axis=0)
+        # would, without its sort of n rows: one integer key per cell, compacted by a count
+        dims = cell.max(axis=0) + 1
+        key = (cell[:, 0] * dims[1] + cell[:, 1]) * dims[2] + cell[:, 2]
+        present = np.bincount(key, minlength=int(np.prod(dims))) > 0
+        lab = (np.cumsum(present) - 1)[key]
+        return lab, int(present.sum())
 
     def _setup(self, A):
         super()._setup(A)
@@ -318,7 +323,12 @@ class DeflatedCGSolver(CGSolver):
         self._WtA = sp.csr_matrix((np.zeros(ukey.size), (ukey % n).astype(np.int32), indptr), shape=(k, n))
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
-        uek, eslot = np.unique(ekey, return_inverse=True)
+        if k * k <= 50_000_000:          # the keys fit a count: the same sorted keys, no sort of nnz
+            present = np.bincount(ekey, minlength=k * k) > 0
+            uek = np.flatnonzero(present)
+            eslot = (np.cumsum(present) - 1)[ekey]
+        else:
+            uek, eslot = np.unique(ekey, return_inverse=True)
         self._e_key, self._e_slot = uek, eslot
         self._coarse_values()
 
