@@ -260,17 +260,30 @@ class DeflatedCGSolver(CGSolver):
         Cluster edge length in mean neighbour spacings (default 3, the fastest measured on
         the rod packings: 35 iterations at 5,000 and 20,000 elements against 134 and 209
         for Jacobi-CG).
+    max_clusters : int or None
+        When ``cluster_size`` would make more clusters than this, the clusters grow until
+        there are about this many (None: never). The coarse matrix's LU costs more than the
+        iterations the extra clusters save: on the lattice rods of ``bench/bench_scale.py``
+        at 1M unknowns, 37,044 clusters took 10.9 s (8.2 s of setup, 32 iterations) and
+        5,082 took 4.0 s (60 iterations); at 500k, 19,074 took 4.1 s and 2,673 took 1.6 s.
     """
 
     name = "cg-deflated"
+    #: default ``max_clusters``
+    MAX_CLUSTERS = 2000
     #: up to this many clusters the coarse matrix is factorised dense (Cholesky), above it sparse (LU)
     DENSE_LIMIT = 400
 
-    def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, cluster_size: float = 3.0):
+    def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, cluster_size: float = 3.0,
+                 max_clusters: Optional[int] = MAX_CLUSTERS):
         super().__init__(rtol=rtol, preconditioner="jacobi", maxiter=maxiter)
         if not cluster_size > 0:
             raise ValueError(f"cluster_size must be > 0, got {cluster_size}")
+        if max_clusters is not None and not int(max_clusters) >= 1:
+            raise ValueError(f"max_clusters must be >= 1 or None, got {max_clusters}")
         self.cluster_size = float(cluster_size)
+        self.max_clusters = None if max_clusters is None else int(max_clusters)
+        self.cluster_size_used = None
         self._coords = None
         self._spacing = None
 
@@ -297,14 +310,24 @@ class DeflatedCGSolver(CGSolver):
         h = self._spacing
         if not h or not np.isfinite(h) or h <= 0:
             h = float(np.prod(np.maximum(hi - lo, 1e-300))) ** (1 / 3) / max(n, 1) ** (1 / 3)
-        cell = np.floor((X - lo) / (self.cluster_size * h)).astype(np.int64)
-        # the cells numbered in lexicographic (x, y, z) order, as np.unique(cell, axis=0)
-        # would, without its sort of n rows: one integer key per cell, compacted by a count
+        size = self.cluster_size
+        lab, k = self._cells(X, lo, size * h)
+        if self.max_clusters and k > self.max_clusters:       # larger clusters, fewer of them
+            size *= (k / self.max_clusters) ** (1.0 / 3.0)
+            lab, k = self._cells(X, lo, size * h)
+        self.cluster_size_used = size
+        return lab, k
+
+    @staticmethod
+    def _cells(X, lo, edge):
+        """Labels 0..k-1 of the cubic cells of side ``edge`` holding the points, numbered in
+        lexicographic (x, y, z) order as np.unique(cell, axis=0) would, without its sort of n
+        rows: one integer key per cell, compacted by a count."""
+        cell = np.floor((X - lo) / edge).astype(np.int64)
         dims = cell.max(axis=0) + 1
         key = (cell[:, 0] * dims[1] + cell[:, 1]) * dims[2] + cell[:, 2]
         present = np.bincount(key, minlength=int(np.prod(dims))) > 0
-        lab = (np.cumsum(present) - 1)[key]
-        return lab, int(present.sum())
+        return (np.cumsum(present) - 1)[key], int(present.sum())
 
     def _setup(self, A):
         super()._setup(A)
@@ -374,6 +397,7 @@ class DeflatedCGSolver(CGSolver):
     def solve(self, A, b, x0=None, atol: float = 0.0):
         x, info = super().solve(A, b, x0, atol)
         info["clusters"] = self._k
+        info["cluster_size"] = self.cluster_size_used
         return x, info
 
 
