@@ -95,6 +95,15 @@ def jittered_rod(n, seed=1):
     return g, np.arange(grid.shape[0] - layer, grid.shape[0]), np.arange(layer)
 
 
+def reduced_rod_system(g, top, bottom, c):
+    """The reduced system of the rod with ``top`` at 1 V and ``bottom`` at 0 V: (ReducedSystem,
+    K_uu, K_ud, b = -K_ud u_d, coordinates of the unknowns)."""
+    from yade_electro.condensation import ReducedSystem
+    rs = ReducedSystem(g.n_nodes, g.edges, [top, bottom])
+    Kuu, Kud = rs.assemble(c)
+    return rs, Kuu, Kud, -(Kud @ np.array([1.0, 0.0])), g.pos[rs.unknown_nodes]
+
+
 def write_system(path, A, b, repeat=1):
     A = A.tocsr()
     with open(path, "wb") as fh:
@@ -115,7 +124,6 @@ def run_eigen(exe, path):
 
 def bench_size(n, repeat, exe, tmp):
     from yade_electro.conductance import conductance
-    from yade_electro.condensation import ReducedSystem
     from yade_electro.network import ConductionProblem, Electrode
     from yade_electro.solvers import auto_solver_name, make_solver
     row = {"bench": "scale", "law": "continuum"}
@@ -144,11 +152,8 @@ def bench_size(n, repeat, exe, tmp):
     row["R_eq_ohm"] = float(sol.equivalent_resistance("top", "bottom"))
     row["joule_W"] = float(joule.sum())
     # the reduced system, solved by each side
-    rs = ReducedSystem(g.n_nodes, g.edges, [top, bottom])
-    Kuu, Kud = rs.assemble(c)
-    b = -(Kud @ np.array([1.0, 0.0]))
+    rs, Kuu, Kud, b, coords = reduced_rod_system(g, top, bottom, c)
     nu = Kuu.shape[0]
-    coords = g.pos[rs.unknown_nodes]
     sysfile = os.path.join(tmp, "system.bin")
     write_system(sysfile, Kuu, b)
     name = auto_solver_name(nu)

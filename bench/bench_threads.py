@@ -31,18 +31,14 @@ def main(argv=None):
     ap.add_argument("--sizes", default="5000,20000,100000")
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    from bench_scale import RADIUS, RHO, jittered_rod
-    from yade_electro.condensation import ReducedSystem
+    from bench_scale import RADIUS, RHO, jittered_rod, reduced_rod_system
     from yade_electro.conductance import conductance
     from yade_electro.solvers import make_solver
     from yade_electro.threads import blas_threads, limit_blas_threads
     start = blas_threads()
     for n in (int(s) for s in args.sizes.split(",")):
         g, top, bottom = jittered_rod(n)
-        rs = ReducedSystem(g.n_nodes, g.edges, [top, bottom])
-        Kuu, Kud = rs.assemble(conductance(g, RHO, "continuum"))
-        b = -(Kud @ np.array([1.0, 0.0]))
-        coords = g.pos[rs.unknown_nodes]
+        _, Kuu, _, b, coords = reduced_rod_system(g, top, bottom, conductance(g, RHO, "continuum"))
         for name in ("cg", "cg-deflated"):
             best = {1: np.inf, 2: np.inf}
             for _ in range(args.repeat):

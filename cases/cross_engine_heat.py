@@ -159,17 +159,18 @@ def decay_time(t, T1, T2):
     return float(-1.0 / np.polyfit(np.asarray(t)[ok], np.log(d[ok]), 1)[0])
 
 
-def compare(problem, out_dir, n=2000, calls_per_dump=100, _settled={}):
-    """Run ``problem`` in both engines; returns its figures and curves."""
+def compare(problem, out_dir, n=2000, calls_per_dump=100, settled_bed=None):
+    """Run ``problem`` in both engines; returns its figures and curves. ``settled_bed``: the
+    result of :func:`settled_particles` for the packing problems (made here when None)."""
     work = os.path.join(out_dir, problem)
     floor = problem == "floor"
     if problem == "two_spheres":
         data, init, mat = two_sphere_particles()
         timestep, steps, dump_every, extra = 1e-5, 20000, 2000, {}
     else:
-        if n not in _settled:               # the packing and floor problems share one packing
-            _settled[n] = settled_particles(n, os.path.join(out_dir, "settle"))
-        data, init, mat, settled = _settled[n]
+        if settled_bed is None:
+            settled_bed = settled_particles(n, os.path.join(out_dir, "settle"))
+        data, init, mat, settled = settled_bed
         if floor:
             init = {}                       # every particle cold, the floor hot
         timestep, steps, dump_every = 1e-4, 10000, 500
@@ -271,8 +272,10 @@ def main(argv=None):
     problems = PROBLEMS if args.problem == "all" else (args.problem,)
     os.makedirs(args.out, exist_ok=True)
     rows, curves = {}, {}
+    # the packing and floor problems share one settled packing
+    bed = settled_particles(args.n, os.path.join(args.out, "settle")) if set(problems) - {"two_spheres"} else None
     for problem in problems:
-        rows[problem], curves[problem] = compare(problem, args.out, args.n, args.calls_per_dump)
+        rows[problem], curves[problem] = compare(problem, args.out, args.n, args.calls_per_dump, bed)
         r = rows[problem]
         print(f"cross-engine heat, {problem} ({r['n']} particles, {r['liggghts_contacts']} contacts): max |dT| "
               f"{r['max_rel_diff_pct']:.2e} % of the range over {r['dumps']} dumps; contacts in one engine only: "

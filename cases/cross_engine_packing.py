@@ -89,6 +89,13 @@ def random_placement(radii, region, seed=1, max_tries=20000):
     order = np.argsort(-radii, kind="stable")
     cell = 2.0 * float(radii.max())
     grid, placed = {}, np.zeros((radii.size, 3))
+    shifts = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
+
+    def free(p, r, key):
+        """No placed sphere in the 27 cells around ``key`` overlaps a sphere r at p."""
+        return not any(np.sum((placed[j] - p) ** 2) < (r + radii[j]) ** 2
+                       for dx, dy, dz in shifts for j in grid.get((key[0] + dx, key[1] + dy, key[2] + dz), ()))
+
     for k in order:
         r = radii[k]
         for _ in range(max_tries):
@@ -96,21 +103,7 @@ def random_placement(radii, region, seed=1, max_tries=20000):
             ang = 2.0 * math.pi * rng.random()
             p = np.array([rho * math.cos(ang), rho * math.sin(ang), rng.uniform(region.z_low + r, region.z_high - r)])
             key = tuple((p // cell).astype(int))
-            ok = True
-            for dx in (-1, 0, 1):
-                for dy in (-1, 0, 1):
-                    for dz in (-1, 0, 1):
-                        for j in grid.get((key[0] + dx, key[1] + dy, key[2] + dz), ()):
-                            if np.sum((placed[j] - p) ** 2) < (r + radii[j]) ** 2:
-                                ok = False
-                                break
-                        if not ok:
-                            break
-                    if not ok:
-                        break
-                if not ok:
-                    break
-            if ok:
+            if free(p, r, key):
                 placed[k] = p
                 grid.setdefault(key, []).append(k)
                 break

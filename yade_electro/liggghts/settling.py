@@ -19,7 +19,13 @@ from .deck import GranularMaterial, material_commands, primes_from, render_deck,
 from .dumps import read_dump_frames
 from .runner import LiggghtsRun, run_deck
 
-__all__ = ["CylinderRegion", "BlockRegion", "SettledPacking", "settle_deck", "settle_packing"]
+__all__ = ["CylinderRegion", "BlockRegion", "SettledPacking", "settle_deck", "settle_packing", "INSERT_TIME",
+           "KE_THRESHOLD"]
+
+#: defaults of :func:`settle_deck` (and so of :func:`settle_packing`): the time [s] the insertion
+#: runs before the settling chunks, and the kinetic energy per particle [J] below which it stops
+INSERT_TIME = 0.1
+KE_THRESHOLD = 1e-9
 
 
 @dataclass(frozen=True)
@@ -83,7 +89,7 @@ class SettledPacking:
 
 def settle_deck(walls, region, n_particles: int, radii, mass_fractions, material: GranularMaterial,
                 box, timestep: float, settle_time: float = 2.0, chunk_time: float = 0.05,
-                insert_time: float = 0.1, ke_threshold: float = 1e-9, contact_model: str = "hertz",
+                insert_time: float = INSERT_TIME, ke_threshold: float = KE_THRESHOLD, contact_model: str = "hertz",
                 seed: int = 32452843, neighbor_skin: Optional[float] = None) -> str:
     """The ``settle`` deck: ``n_particles`` of the size classes ``radii`` [m] (with their
     ``mass_fractions``) inserted in ``region`` inside the container ``walls``, within the
@@ -121,7 +127,7 @@ def settle_packing(walls, region, n_particles: int, radii, mass_fractions, mater
     ``n`` is what it inserted."""
     deck = settle_deck(walls, region, n_particles, radii, mass_fractions, material, box, timestep,
                        settle_time=settle_time, **deck_options)
-    total = int(round(settle_time / timestep)) + int(round(deck_options.get("insert_time", 0.1) / timestep))
+    total = int(round(settle_time / timestep)) + int(round(deck_options.get("insert_time", INSERT_TIME) / timestep))
     run = run_deck(deck, workdir, exe=exe, timeout=timeout, progress=progress, total_steps=total, total_is_bound=True)
     frame = read_dump_frames(run.workdir / "settled.dump")[-1]
     df = frame.data
@@ -129,7 +135,7 @@ def settle_packing(walls, region, n_particles: int, radii, mass_fractions, mater
     if m is None:
         raise RuntimeError(f"the settle run ended without its end line; see {run.log}")
     step, ke = int(m.group(1)), float(m.group(2))
-    threshold = float(deck_options.get("ke_threshold", 1e-9))
+    threshold = float(deck_options.get("ke_threshold", KE_THRESHOLD))
     if len(df) < n_particles:
         import warnings
         warnings.warn(f"LIGGGHTS inserted {len(df)} of the {n_particles} particles asked for (the insertion region "

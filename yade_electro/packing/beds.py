@@ -26,14 +26,10 @@ SCALARS = ("n", "bed_height_m", "volume_fraction", "volume_fraction_core", "volu
 
 
 def contact_pairs(centers, radii) -> np.ndarray:
-    """Index pairs (m, 2) of the spheres that overlap (d_ij < r_i + r_j)."""
-    c = np.asarray(centers, dtype=float)
-    r = np.asarray(radii, dtype=float)
-    pairs = cKDTree(c).query_pairs(2.0 * float(r.max()), output_type="ndarray")
-    if len(pairs) == 0:
-        return np.zeros((0, 2), dtype=np.int64)
-    d = np.linalg.norm(c[pairs[:, 0]] - c[pairs[:, 1]], axis=1)
-    return pairs[d < r[pairs[:, 0]] + r[pairs[:, 1]]].astype(np.int64)
+    """Index pairs (m, 2) of the spheres that overlap (d_ij < r_i + r_j): the bond rule with
+    detection factor 1."""
+    from .statistics import bond_pairs
+    return bond_pairs(centers, radii, detection_factor=1.0)
 
 
 def volume_fraction_samples(centers, radii, points, k: int = 12) -> np.ndarray:
