@@ -209,3 +209,15 @@ def test_settle_on_an_stl_floor(liggghts_exe, tmp_path):
     assert p.n == 60 and p.settled
     bottom = p.centers[:, 2] - p.radii
     assert bottom.min() > -0.02 * 0.7e-3 and np.sum(bottom < 0.05 * 0.7e-3) >= 10     # resting on the mesh
+
+
+def test_bad_heat_deck_inputs_are_refused():
+    d = L.particle_data([[0, 0, 0], [3.8e-3, 0, 0]], 2e-3, 8900.0)
+    with pytest.raises(ValueError, match="temperature must be finite and > 0"):
+        L.heat_conduction_deck(d, [COPPER], -5.0, 1e-5, 10, 5)
+    with pytest.raises(ValueError, match="timestep must be > 0"):
+        L.heat_conduction_deck(d, [COPPER], 300.0, 0.0, 10, 5)
+    with pytest.raises(ValueError, match="atom ids not in the data"):
+        L.heat_conduction_deck(d, [COPPER], 300.0, 1e-5, 10, 5, initial_temperature={7: 400.0})
+    with pytest.raises(ValueError, match="area_correction needs young_original"):
+        L.heat_conduction_deck(d, [COPPER], 300.0, 1e-5, 10, 5, area_correction=True)

@@ -506,3 +506,23 @@ def test_cg_that_cannot_converge_raises(random_network):
     g, c, a, b, _ = random_network
     with pytest.raises(SolverError, match="did not converge.*solver='direct'"):
         solve_potential(g.n_nodes, g.edges, c, two_electrodes(a, b), solver=CGSolver(maxiter=2))
+
+
+def test_deflation_caps_its_clusters():
+    """With more clusters than max_clusters the clusters grow until there are about that many;
+    the solution stays the same to the tolerance; a bad cap is refused."""
+    from yade_electro.network import laplacian
+    from yade_electro.solvers import DeflatedCGSolver
+    g = cubic_lattice((12, 12, 48), 0.5e-3)
+    A = (laplacian(g.edges, np.ones(len(g.edges)), g.n_nodes) + 1e-3 * sp.eye(g.n_nodes)).tocsr()   # SPD
+    b = np.random.default_rng(0).random(g.n_nodes)
+    out = {}
+    for cap in (None, 50):
+        s = DeflatedCGSolver(max_clusters=cap)
+        s.set_geometry(g.pos, 1e-3)
+        out[cap] = s.solve(A, b)
+    assert out[None][1]["clusters"] > 50 and out[None][1]["cluster_size"] == 3.0
+    assert out[50][1]["clusters"] <= 2 * 50 and out[50][1]["cluster_size"] > 3.0
+    np.testing.assert_allclose(out[50][0], out[None][0], rtol=1e-7)
+    with pytest.raises(ValueError, match="max_clusters must be >= 1"):
+        DeflatedCGSolver(max_clusters=0)
