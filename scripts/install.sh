@@ -21,12 +21,14 @@ PY="${PY:-/usr/bin/python3}"
 # Debian packages. python3-setuptools/-wheel: the editable install builds with them
 # (--no-build-isolation, so pip fetches no setuptools from PyPI). g++ and libeigen3-dev:
 # bench/bench_scale.py builds an Eigen ConjugateGradient driver to compare the solves with.
+# python3-petsc4py, python3-mpi4py, openmpi-bin: solver='petsc' and runs under mpiexec.
 DEB_PACKAGES=(
   yade liggghts
   python3-pip python3-setuptools python3-wheel
   python3-numpy python3-scipy python3-pandas python3-matplotlib python3-pytest python3-meshio
   gmsh python3-gmsh
   g++ libeigen3-dev
+  python3-petsc4py python3-mpi4py openmpi-bin
 )
 
 # PyPI packages Debian 12 lacks, pinned to the newest release that declares support for
@@ -161,9 +163,12 @@ basis = Basis(MeshTet().refined(2), ElementTetP1())
 u = solve(*condense(laplace.assemble(basis), unit_load.assemble(basis),
                     D=basis.mesh.boundary_nodes()))
 assert 0.0 < u.max() < 0.1, "scikit-fem Poisson solve gave %r" % u.max()
-print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; yade_electro from %s"
+# petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.petsc_solver finds it)
+from yade_electro.petsc_solver import import_petsc
+PETSc = import_petsc()
+print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; PETSc %s; yade_electro from %s"
       % (numpy.__version__, scipy.__version__, pyamg.__version__, skfem.__version__,
-         importlib.util.find_spec("yade_electro").origin))
+         ".".join(map(str, PETSc.Sys.getVersion())), importlib.util.find_spec("yade_electro").origin))
 EOF
 command -v yade >/dev/null 2>&1 || die "yade not on PATH after installing the Debian package"
 command -v yade-electro >/dev/null 2>&1 || die "yade-electro (the launcher without open ports) not on PATH after the install"

@@ -27,6 +27,9 @@ Solvers
     its finest operator replaced; it is rebuilt when an iteration count exceeds
     ``resetup_factor`` (1.5) times the count of the first solve after the last setup, i.e.
     when the kept hierarchy no longer fits the matrix (large value changes).
+``'petsc'``
+    PETSc's CG + GAMG through petsc4py, distributed over the ranks of ``mpiexec`` (see
+    :mod:`yade_electro.petsc_solver`; imported only when asked for).
 ``'direct'``
     Sparse LU (SuperLU). ``update``: refactorisation (there is no cheaper exact update).
 ``'auto'``
@@ -456,9 +459,13 @@ _SOLVERS = {"direct": DirectSolver, "cg": CGSolver, "cg-jacobi": CGSolver, "cg-d
             "cg-amg": AMGSolver}
 
 
+#: solvers in modules of their own, imported when asked for (their dependencies are optional)
+_LAZY_SOLVERS = ("petsc",)
+
+
 def solver_names() -> tuple:
     """Names :func:`make_solver` knows (plus ``'auto'``)."""
-    return tuple(sorted(list(_SOLVERS) + ["auto"]))
+    return tuple(sorted(list(_SOLVERS) + list(_LAZY_SOLVERS) + ["auto"]))
 
 
 def make_solver(solver="auto", n_unknowns: Optional[int] = None, **kw):
@@ -470,6 +477,9 @@ def make_solver(solver="auto", n_unknowns: Optional[int] = None, **kw):
         if n_unknowns is None:
             raise ValueError("solver='auto' needs the number of unknowns")
         solver = auto_solver_name(n_unknowns)
+    if solver == "petsc":
+        from .petsc_solver import PETScSolver
+        return PETScSolver(**kw)
     try:
         cls = _SOLVERS[solver]
     except (KeyError, TypeError):
@@ -487,8 +497,11 @@ def check_solver_name(solver) -> None:
     """Raise ValueError for an unknown solver name (objects with ``solve`` pass)."""
     if hasattr(solver, "solve"):
         return
-    if solver != "auto" and solver not in _SOLVERS:
+    if solver != "auto" and solver not in _SOLVERS and solver not in _LAZY_SOLVERS:
         raise ValueError(f"unknown solver {solver!r}; known: {', '.join(solver_names())}")
+    if solver == "petsc":                # missing petsc4py: say so when the engine is built
+        from .petsc_solver import import_petsc
+        import_petsc()
 
 
 __all__ += ["check_solver_name"]

@@ -31,6 +31,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import os
+import sys
 import warnings
 from typing import Dict, Optional
 
@@ -213,6 +214,8 @@ class _Engine:
         try:
             if self.removed:
                 raise RuntimeError(f"engine {self.label!r} was removed")
+            if in_mpy_subdomain():
+                raise RuntimeError(MPY_REFUSAL.format(label=self.label))
             if self.reader.scene_replaced:
                 self._reattach_in_place()
             out = fn()
@@ -229,6 +232,20 @@ class _Engine:
         if self.plot:
             from yade import plot
             plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
+
+
+#: why an engine does not run inside yade.mpy's domain decomposition
+MPY_REFUSAL = ("engine {label!r}: this scene is a subdomain of yade.mpy's decomposition (O.subD is set): the "
+               "engine would see only this rank's bodies and give wrong results. Run the whole scene on every "
+               "rank (mpiexec without mpy.mpirun) with solver='petsc' to share the solve, or call the engine on "
+               "the master's merged scene after mpy.mpirun(..., withMerge=True)")
+
+
+def in_mpy_subdomain() -> bool:
+    """True when yade.mpy has split the scene into subdomains (it sets ``O.subD`` on its own
+    Omega handle when ``mpirun`` starts; plain ``mpiexec`` runs without mpirun do not)."""
+    mpy = sys.modules.get("yade.mpy")
+    return mpy is not None and getattr(getattr(mpy, "O", None), "subD", None) is not None
 
 
 # =========================================================================================
