@@ -13,10 +13,12 @@ script's namespace, ``-x``, ``readParamsFromTable``) is YADE's::
 
     yade-electro -n -x script.py [args]          # instead of:  yade -n -x script.py [args]
     yade-electro batch table script.py [opts]    # instead of:  yade-batch table script.py
+    yade-electro gather 'logs/*.log' --out t.csv # the jobs' final JSON lines in one table
 
 ``batch`` runs ``yade-batch`` with its jobs started by this launcher (``--executable``) and
 without its own HTTP summary server (port 9080 on all interfaces): the jobs' logs are the
-record. ``python3 -m yade_electro.yade.launcher`` is the same command.
+record. ``gather`` reads those logs (:mod:`yade_electro.campaign`; no YADE needed).
+``python3 -m yade_electro.yade.launcher`` is the same command.
 
 Environment: ``YADE_ELECTRO_YADE`` / ``YADE_ELECTRO_YADE_BATCH`` name other YADE launchers.
 """
@@ -101,13 +103,41 @@ def _self_command() -> str:
     return f"{shlex.quote(sys.executable)} -m yade_electro.yade.launcher"
 
 
+def made_log_directories(args) -> list:
+    """Create the directories the jobs' logs go to. yade-batch replaces ``$`` in ``--log`` by
+    the script's path as given (``cases/x.py``: a subdirectory), ``%`` by the line number and
+    ``@`` by the description, and it hangs, its jobs never started, when that directory does
+    not exist. Returns the directories created."""
+    pattern, positional = "$.@.log", []
+    it = iter(args)
+    for a in it:
+        if a == "--log":
+            pattern = next(it, pattern)
+        elif a.startswith("--log="):
+            pattern = a.split("=", 1)[1]
+        elif not a.startswith("-"):
+            positional.append(a)
+    scripts = [p for p in positional if p.endswith(".py")] or [""]
+    made = []
+    for script in scripts:
+        d = os.path.dirname(pattern.replace("$", script))
+        if d and "@" not in d and "%" not in d and not os.path.isdir(d):
+            os.makedirs(d, exist_ok=True)
+            made.append(d)
+    return made
+
+
 def main(argv=None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["gather"]:
+        from ..campaign import main as gather_main
+        sys.exit(gather_main(argv[1:]))
     if argv[:1] == ["batch"]:
         args = argv[1:]
         if not any(a == "--executable" or a.startswith("--executable=") for a in args):
             args = ["--executable", _self_command()] + args
         _disable_batch_http()
+        made_log_directories(args)
         path = find_launcher("yade-batch", "YADE_ELECTRO_YADE_BATCH")
         sys.argv = [path] + args
         _run_as_main(path)
