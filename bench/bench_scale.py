@@ -23,8 +23,14 @@ last layer) are the electrodes at 1 V / 0 V; law ``continuum``, rho_e of 304L. F
 * the load average, and the BLAS thread limit (OpenBLAS is held to one thread here, as
   inside YADE; see the README's *Scale* section).
 
+``--laws voronoi`` (default: both) times the ``voronoi`` law's pipeline instead, each size in
+a process of its own: the rod in its box, stages graph / tessellation (bounded Voronoi
+cells, faces and the conducting network) / conductances / cold solve / Joule, wall and CPU
+time (the tessellation runs in slabs on ``YADE_ELECTRO_TESSELLATION_THREADS`` threads,
+default all cores), peak RSS, and R_eq against rho L / A between the electrode layers.
+
 Run (no YADE needed): ``/usr/bin/python3 bench/bench_scale.py [--sizes 5000,20000,100000]``.
-One JSON line per size.
+One JSON line per size and law.
 """
 from __future__ import annotations
 
@@ -201,16 +207,77 @@ def bench_size(n, repeat, exe, tmp):
     return row
 
 
+def bench_voronoi(n):
+    """The ``voronoi`` law's pipeline on the rod of about n elements in its box: graph,
+    tessellation (bounded cells, faces, the conducting network), conductances, the cold
+    ConductionProblem solve, Joule heat. Run in a process of its own (peak RSS per size)."""
+    from yade_electro.conductance import make_law
+    from yade_electro.geometry import Box
+    from yade_electro.network import ConductionProblem, Electrode
+    from yade_electro.tessellation import tessellation_threads
+    row = {"bench": "scale", "law": "voronoi"}
+    st = {}
+    cpu0 = time.process_time()
+    t = time.perf_counter()
+    g, top, bottom = jittered_rod(n)
+    st["graph"] = time.perf_counter() - t
+    row["n"] = int(g.n_nodes)
+    lo, hi = g.pos.min(axis=0) - RADIUS, g.pos.max(axis=0) + RADIUS
+    law = make_law("voronoi", container=Box(lo, hi))
+    t = time.perf_counter()
+    edges = law.network(g)
+    st["tessellation"] = time.perf_counter() - t
+    log(f"n = {g.n_nodes}: voronoi faces and network {st['tessellation']:.1f} s ({len(edges)} edges)")
+    t = time.perf_counter()
+    c = law.factor(g, edges) / RHO
+    st["conductances"] = time.perf_counter() - t
+    t = time.perf_counter()
+    el = [Electrode("top", top, potential=1.0), Electrode("bottom", bottom, potential=0.0)]
+    sol = ConductionProblem(g.n_nodes, edges, c, el, solver="auto", coords=g.pos).solve()
+    st["solve"] = time.perf_counter() - t
+    t = time.perf_counter()
+    joule = c * (sol.potential[edges[:, 0]] - sol.potential[edges[:, 1]]) ** 2
+    st["joule"] = time.perf_counter() - t
+    wall = float(sum(st.values()))
+    # the nominal resistance between the electrode layers' centres, in the box's cross-section
+    length = float(g.pos[top, 2].mean() - g.pos[bottom, 2].mean())
+    area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
+    R = float(sol.equivalent_resistance("top", "bottom"))
+    row.update({"stages_s": st, "pipeline_s": wall, "cpu_s": time.process_time() - cpu0,
+                "edges": int(len(edges)), "R_eq_ohm": R, "R_nominal_ohm": RHO * length / area,
+                "R_rel_diff": R / (RHO * length / area) - 1.0, "joule_W": float(joule.sum()),
+                "tessellation_threads": tessellation_threads(),
+                "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+                "loadavg": os.getloadavg()[0]})
+    return row
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sizes", default="5000,20000,100000,500000,1000000")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--laws", default="continuum,voronoi",
+                    help="continuum: pipeline + solver comparison; voronoi: its pipeline, each size in a process of its own")
+    ap.add_argument("--voronoi-worker", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    exe = eigen_driver()
+    if args.voronoi_worker:
+        print(json.dumps(bench_voronoi(args.voronoi_worker)), flush=True)
+        return []
+    laws = args.laws.split(",")
     rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        for n in (int(s) for s in args.sizes.split(",")):
-            row = bench_size(n, args.repeat, exe, tmp)
+    sizes = [int(s) for s in args.sizes.split(",")]
+    if "continuum" in laws:
+        exe = eigen_driver()
+        with tempfile.TemporaryDirectory() as tmp:
+            for n in sizes:
+                row = bench_size(n, args.repeat, exe, tmp)
+                rows.append(row)
+                print(json.dumps(row), flush=True)
+    if "voronoi" in laws:
+        for n in sizes:
+            out = subprocess.run([sys.executable, os.path.abspath(_SCRIPT), "--voronoi-worker", str(n)],
+                                 check=True, stdout=subprocess.PIPE, text=True)
+            row = json.loads(out.stdout.strip().splitlines()[-1])
             rows.append(row)
             print(json.dumps(row), flush=True)
     return rows

@@ -22,6 +22,8 @@ PY="${PY:-/usr/bin/python3}"
 # (--no-build-isolation, so pip fetches no setuptools from PyPI). g++ and libeigen3-dev:
 # bench/bench_scale.py builds an Eigen ConjugateGradient driver to compare the solves with.
 # python3-petsc4py, python3-mpi4py, openmpi-bin: solver='petsc' and runs under mpiexec.
+# libcgal-dev: the Delaunay triangulation of the 'voronoi' law (yade_electro/native, built
+# on first use with g++; scipy's qhull is the fallback).
 DEB_PACKAGES=(
   yade liggghts
   python3-pip python3-setuptools python3-wheel
@@ -29,6 +31,7 @@ DEB_PACKAGES=(
   gmsh python3-gmsh
   g++ libeigen3-dev
   python3-petsc4py python3-mpi4py openmpi-bin
+  libcgal-dev
 )
 
 # PyPI packages Debian 12 lacks, pinned to the newest release that declares support for
@@ -166,6 +169,9 @@ assert 0.0 < u.max() < 0.1, "scikit-fem Poisson solve gave %r" % u.max()
 # petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.petsc_solver finds it)
 from yade_electro.petsc_solver import import_petsc
 PETSc = import_petsc()
+# the CGAL Delaunay helper: built now, once, so that the first 'voronoi' run does not wait
+from yade_electro.native import cgal_executable
+cgal_executable()
 print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; PETSc %s; yade_electro from %s"
       % (numpy.__version__, scipy.__version__, pyamg.__version__, skfem.__version__,
          ".".join(map(str, PETSc.Sys.getVersion())), importlib.util.find_spec("yade_electro").origin))

@@ -40,10 +40,12 @@ Units: metres, m^2.
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import Voronoi
+
+from .tessellation import tessellate
 
 __all__ = ["voronoi_faces", "ghost_points", "bounded_cells", "BoundedCells", "VoronoiFaces"]
 
@@ -83,30 +85,6 @@ def ghost_points(pos, radius, container=None, band=None, neighbour_barycentre=No
         foot = pos[near] + radius[near, None] * nrm             # sphere tangent plane
     ghosts = 2.0 * foot - pos[near]
     return ghosts, foot, nrm, near
-
-
-def _polygon_areas(vertices, ridge_vertices, normals):
-    """Areas of planar convex polygons given by unordered vertex index lists."""
-    areas = np.zeros(len(ridge_vertices))
-    counts = np.array([len(r) for r in ridge_vertices])
-    for k in np.unique(counts):
-        sel = np.flatnonzero(counts == k)
-        idx = np.array([ridge_vertices[s] for s in sel])
-        pts = vertices[idx]                                   # (m, k, 3)
-        cen = pts.mean(axis=1, keepdims=True)
-        q = pts - cen
-        nrm = normals[sel]
-        a = np.cross(nrm, np.array([1.0, 0.0, 0.0]))
-        bad = np.linalg.norm(a, axis=1) < 0.1
-        a[bad] = np.cross(nrm[bad], np.array([0.0, 1.0, 0.0]))
-        a /= np.linalg.norm(a, axis=1)[:, None]
-        b = np.cross(nrm, a)
-        ang = np.arctan2(np.einsum("mkj,mj->mk", q, b), np.einsum("mkj,mj->mk", q, a))
-        order = np.argsort(ang, axis=1)
-        q = np.take_along_axis(q, order[:, :, None], axis=1)
-        cr = np.cross(q, np.roll(q, -1, axis=1)).sum(axis=1)
-        areas[sel] = 0.5 * np.abs(np.einsum("mj,mj->m", cr, nrm))
-    return areas
 
 
 def _order(poly, normal):
@@ -214,13 +192,32 @@ def _clipped_by_planes(poly, normal, planes):
 
 def _tessellate(pos, radius, ghosts):
     """Voronoi tessellation of the elements, their ghosts and eight far points (which keep
-    every cell of a real element finite). Returns (all points, scipy Voronoi)."""
+    every cell of a real element finite). Returns (all points, :class:`Tessellation` with the
+    faces of the elements: with each other and with ghosts)."""
     lo, hi = pos.min(axis=0), pos.max(axis=0)
     span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
     mid = 0.5 * (lo + hi)
     far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     pts = np.concatenate([pos, ghosts, far])
-    return pts, Voronoi(pts)
+    return pts, tessellate(pts, pos.shape[0], n_far=far.shape[0], progress=_progress_lines(pts.shape[0]))
+
+
+#: seconds between progress lines of a long tessellation
+PROGRESS_EVERY = 10.0
+
+
+def _progress_lines(n_points):
+    """A progress callback printing a line to stderr at most every PROGRESS_EVERY s, with
+    the slabs done and an estimate of the time left."""
+    last = [0.0]
+
+    def progress(done, total, elapsed):
+        if elapsed - last[0] >= PROGRESS_EVERY or (done == total and elapsed >= PROGRESS_EVERY):
+            last[0] = elapsed
+            left = elapsed / done * (total - done)
+            print(f"[voronoi] {n_points} points: {done} of {total} slabs tessellated in {elapsed:.0f} s, "
+                  f"about {left:.0f} s left", file=sys.stderr, flush=True)
+    return progress
 
 
 @dataclass(frozen=True, eq=False)
@@ -310,18 +307,6 @@ def _protrusion_integral(verts, count, centre, container, signed=True):
     return np.where(valid, tri, 0.0).sum(axis=1)
 
 
-def _ridge_polygons(vor, ridges):
-    """Padded vertex arrays (r, P, 3) and counts of Voronoi ridges (unordered vertices)."""
-    rv = [vor.ridge_vertices[k] for k in ridges]
-    count = np.array([len(r) for r in rv], dtype=np.int64)
-    P = int(count.max(initial=3))
-    idx = np.zeros((len(rv), P), dtype=np.int64)
-    for k in np.unique(count):
-        sel = np.flatnonzero(count == k)
-        idx[sel, :k] = np.array([rv[t] for t in sel])
-    return vor.vertices[idx], count
-
-
 def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
                   planes_per_round: int = 2) -> BoundedCells:
     """Voronoi cells of the element centres bounded by the container: faces, volumes and
@@ -352,23 +337,23 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     radius = np.asarray(radius, float)
     n = pos.shape[0]
     ghosts, _, _, _ = ghost_points(pos, radius, container)
-    pts, vor = _tessellate(pos, radius, ghosts)
+    pts, tess = _tessellate(pos, radius, ghosts)
     n_real_and_ghosts = n + ghosts.shape[0]
-    rp = vor.ridge_points
+    rp = tess.ridge_points
     tol0 = rel_tol * 2.0 * float(np.min(radius))
-    vout = np.asarray(container.sdf(vor.vertices), float) > tol0
-    flagged = np.zeros(pts.shape[0], bool)
-    for i in range(n):
-        reg = vor.regions[vor.point_region[i]]
-        flagged[i] = (not reg) or (-1 in reg) or bool(vout[reg].any())
+    vout = np.asarray(container.sdf(tess.vertices), float) > tol0
+    flagged = tess.cells_touching(vout)
+    flagged[n:] = False
     real_pair = (rp[:, 0] < n) & (rp[:, 1] < n)
+    # every face's area, centre and extent (unclipped), in one chunked pass
+    all_area, all_centre, all_extent = tess.face_geometry()
     # --- whole cells: pyramids on their faces, of height l/2 (the face bisects the pair)
     vol = np.zeros(n)
     whole = ~flagged
     sel = np.flatnonzero((whole[rp[:, 0]] & (rp[:, 0] < n)) | (whole[rp[:, 1]] & (rp[:, 1] < n)))
     dvec = pts[rp[sel, 1]] - pts[rp[sel, 0]]
     length = np.linalg.norm(dvec, axis=1)
-    a_sel = _polygon_areas(vor.vertices, [vor.ridge_vertices[k] for k in sel], dvec / length[:, None])
+    a_sel = all_area[sel]
     for side in (0, 1):
         k = whole[rp[sel, side]] & (rp[sel, side] < n)
         np.add.at(vol, rp[sel[k], side], a_sel[k] * length[k] / 6.0)
@@ -377,10 +362,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     pairs = np.sort(rp[pidx], axis=1)
     # each face's centre and extent (its farthest vertex from the centre), of the whole
     # Voronoi polygon: where a crack facet is, and how far it reaches
-    fverts, fcount = _ridge_polygons(vor, pidx)
-    fvalid = np.arange(fverts.shape[1])[None, :] < fcount[:, None]
-    f_centre = np.where(fvalid[:, :, None], fverts, 0.0).sum(axis=1) / np.maximum(fcount, 1)[:, None]
-    f_extent = np.where(fvalid, np.linalg.norm(fverts - f_centre[:, None, :], axis=2), 0.0).max(axis=1)
+    f_centre, f_extent = all_centre[pidx], all_extent[pidx]
     area = np.zeros(pidx.size)
     pos_of = np.full(rp.shape[0], -1, dtype=np.int64)
     pos_of[sel] = np.arange(sel.size)
@@ -398,7 +380,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
         side = np.concatenate([np.zeros(int((flagged[rp[:, 0]] & (rp[:, 0] < n)).sum()), np.int64),
                                np.ones(int((flagged[rp[:, 1]] & (rp[:, 1] < n)).sum()), np.int64)])
         me, other = rp[rows, side], rp[rows, 1 - side]
-        verts, count = _ridge_polygons(vor, rows)
+        verts, count = tess.polygons(rows)
         nrm = pts[other] - pts[me]
         nrm /= np.linalg.norm(nrm, axis=1)[:, None]
         faces = FaceSet(order_polygons(verts, count, nrm), count, local[me], other, nrm)
@@ -550,9 +532,8 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
         if np.any(sampled):
             redo = ~plain & (sampled[pairs[:, 0]] | sampled[pairs[:, 1]])
             for m in np.flatnonzero(redo):
-                r = vor.ridge_vertices[pidx[m]]
                 dn = pts[pairs[m, 1]] - pts[pairs[m, 0]]
-                area[m] = _clipped_area(vor.vertices[r], dn / np.linalg.norm(dn), container)
+                area[m] = _clipped_area(tess.vertices[tess.ridge(pidx[m])], dn / np.linalg.norm(dn), container)
     # ghost faces of whole cells
     gsel = np.flatnonzero(((rp[:, 0] < n) & whole[rp[:, 0]] & (rp[:, 1] >= n) & (rp[:, 1] < n_real_and_ghosts))
                           | ((rp[:, 1] < n) & whole[rp[:, 1]] & (rp[:, 0] >= n) & (rp[:, 0] < n_real_and_ghosts)))
@@ -561,8 +542,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
         gh = np.where(rp[gsel, 0] < n, rp[gsel, 1], rp[gsel, 0])
         gn = pts[gh] - pts[me]
         gn /= np.linalg.norm(gn, axis=1)[:, None]
-        ga = _polygon_areas(vor.vertices, [vor.ridge_vertices[k] for k in gsel], gn)
-        gp = np.array([vor.vertices[vor.ridge_vertices[k]].mean(axis=0) for k in gsel])
+        ga, gp = all_area[gsel], all_centre[gsel]
         b_owner = np.concatenate([b_owner, me])
         b_area = np.concatenate([b_area, ga])
         b_normal = np.concatenate([b_normal, gn])
@@ -597,25 +577,21 @@ def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, thresh
     n = pos.shape[0]
     ghosts, foot, nrm, mirrored = ghost_points(pos, radius, None, neighbour_barycentre=neighbour_barycentre,
                                                threshold=threshold)
-    pts, vor = _tessellate(pos, radius, ghosts)
-    rp = vor.ridge_points
-    keep = (rp[:, 0] < n) & (rp[:, 1] < n)
-    idx = np.flatnonzero(keep)
-    rv = [vor.ridge_vertices[k] for k in idx]
-    finite = np.array([-1 not in r for r in rv], dtype=bool)
-    idx = idx[finite]
-    rv = [r for r, f in zip(rv, finite) if f]
-    pairs = np.sort(rp[idx], axis=1)
+    pts, tess = _tessellate(pos, radius, ghosts)
+    rp = tess.ridge_points
+    idx = np.flatnonzero((rp[:, 0] < n) & (rp[:, 1] < n))
+    pairs = rp[idx]
     d = pts[pairs[:, 1]] - pts[pairs[:, 0]]
     normals = d / np.linalg.norm(d, axis=1)[:, None]
-    area = _polygon_areas(vor.vertices, rv, normals)
+    area = tess.face_geometry(idx, normals)[0]
     # clip by the tangent planes of the surface elements of each face
     plane_of = {int(i): (foot[k], nrm[k]) for k, i in enumerate(mirrored)}
     for m, (i, j) in enumerate(pairs):
         planes = [plane_of[q] for q in (int(i), int(j)) if q in plane_of]
         if planes:
-            area[m] = _clipped_by_planes(vor.vertices[rv[m]], normals[m], planes)
-    return pairs, area
+            area[m] = _clipped_by_planes(tess.vertices[tess.ridge(idx[m])], normals[m], planes)
+    keep = area > 0
+    return pairs[keep], area[keep]
 
 
 class VoronoiFaces:
