@@ -26,8 +26,9 @@ last layer) are the electrodes at 1 V / 0 V; law ``continuum``, rho_e of 304L. F
 ``--laws voronoi`` (default: both) times the ``voronoi`` law's pipeline instead, each size in
 a process of its own: the rod in its box, stages graph / tessellation (bounded Voronoi
 cells, faces and the conducting network) / conductances / cold solve / Joule, wall and CPU
-time (the tessellation runs in slabs on ``YADE_ELECTRO_TESSELLATION_THREADS`` threads,
-default all cores), peak RSS, and R_eq against rho L / A between the electrode layers.
+time (CPU including the CGAL Delaunay helper, a child process; the face geometry runs on
+``YADE_ELECTRO_TESSELLATION_THREADS`` threads, default all cores), peak RSS of the process
+and of the helper, and R_eq against rho L / A between the electrode layers.
 
 Run (no YADE needed): ``/usr/bin/python3 bench/bench_scale.py [--sizes 5000,20000,100000]``.
 One JSON line per size and law.
@@ -243,7 +244,10 @@ def bench_voronoi(n):
     length = float(g.pos[top, 2].mean() - g.pos[bottom, 2].mean())
     area = float((hi[0] - lo[0]) * (hi[1] - lo[1]))
     R = float(sol.equivalent_resistance("top", "bottom"))
-    row.update({"stages_s": st, "pipeline_s": wall, "cpu_s": time.process_time() - cpu0,
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)          # the CGAL helper
+    row.update({"stages_s": st, "pipeline_s": wall,
+                "cpu_s": time.process_time() - cpu0 + kids.ru_utime + kids.ru_stime,
+                "helper_peak_rss_mb": kids.ru_maxrss / 1024.0,
                 "edges": int(len(edges)), "R_eq_ohm": R, "R_nominal_ohm": RHO * length / area,
                 "R_rel_diff": R / (RHO * length / area) - 1.0, "joule_W": float(joule.sum()),
                 "tessellation_threads": tessellation_threads(),

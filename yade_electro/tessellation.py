@@ -36,8 +36,9 @@ __all__ = ["Tessellation", "tessellate", "circumcentres"]
 
 #: the 6 edges of a tetrahedron (vertex positions in a simplex row)
 _TET_EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
-#: faces are processed in chunks of this many rows (bounds the padded arrays' memory)
-CHUNK = 200_000
+#: faces are processed in chunks of this many rows (bounds the arrays' memory), on
+#: :func:`tessellation_threads` threads
+CHUNK = 100_000
 
 
 def circumcentres(points, simplices, neighbors=None):
@@ -91,6 +92,8 @@ class Tessellation:
     ridge_vertex: np.ndarray
     #: (area, centre, extent) of every face, when computed with the tessellation
     geometry: Optional[tuple] = None
+    #: True when each face's vertices are listed in cyclic order (CGAL's edge circulator)
+    ordered: bool = False
 
     @property
     def n_ridges(self) -> int:
@@ -156,20 +159,29 @@ class Tessellation:
             normals = normals / np.linalg.norm(normals, axis=1)[:, None]
         area, centre, extent = np.zeros(rows.size), np.zeros((rows.size, 3)), np.zeros(rows.size)
         count = self.ridge_start[rows + 1] - self.ridge_start[rows]
+        tasks = []
         for k in np.unique(count):
             group = np.flatnonzero(count == k)
-            for s in range(0, group.size, chunk):
-                g = group[s:s + chunk]
-                idx = self.ridge_start[rows[g]][:, None] + np.arange(k)[None, :]
-                v = self.vertices[self.ridge_vertex[idx]]                    # (r, k, 3)
-                a_, c_, e_ = _convex_polygons(v, normals[g])
-                area[g], centre[g], extent[g] = a_, c_, e_
+            tasks += [(int(k), group[s:s + chunk]) for s in range(0, group.size, chunk)]
+
+        def one(task):
+            k, g = task
+            idx = self.ridge_start[rows[g]][:, None] + np.arange(k)[None, :]
+            v = self.vertices[self.ridge_vertex[idx]]                        # (r, k, 3)
+            area[g], centre[g], extent[g] = _convex_polygons(v, normals[g], self.ordered)
+        threads = tessellation_threads() if rows.size > chunk else 1
+        if threads > 1:                    # numpy releases the GIL in the array work
+            with ThreadPoolExecutor(max_workers=threads) as ex:
+                list(ex.map(one, tasks))
+        else:
+            for task in tasks:
+                one(task)
         return area, centre, extent
 
 
-def _convex_polygons(v, normal):
+def _convex_polygons(v, normal, ordered=False):
     """Area, area centroid and extent of convex polygons given by unordered vertices (r, k, 3)
-    in planes of unit ``normal`` (r, 3). Polygons of area below 1e-9 of their squared extent
+    in planes of unit ``normal`` (r, 3) (``ordered``: already in cyclic order). Polygons of area below 1e-9 of their squared extent
     are centred at the mean of their vertices."""
     r, k, _ = v.shape
     mean = v.mean(axis=1)
@@ -182,9 +194,10 @@ def _convex_polygons(v, normal):
     a /= np.linalg.norm(a, axis=1)[:, None]
     b = np.cross(normal, a)
     x, y = np.einsum("rkj,rj->rk", q, a), np.einsum("rkj,rj->rk", q, b)
-    order = np.argsort(np.arctan2(y, x), axis=1)
-    x, y = np.take_along_axis(x, order, axis=1), np.take_along_axis(y, order, axis=1)
-    q = np.take_along_axis(q, order[:, :, None], axis=1)
+    if not ordered:
+        order = np.argsort(np.arctan2(y, x), axis=1)
+        x, y = np.take_along_axis(x, order, axis=1), np.take_along_axis(y, order, axis=1)
+        q = np.take_along_axis(q, order[:, :, None], axis=1)
     # fan triangles from vertex 0, in the polygon's own 2D coordinates
     x1, y1 = x[:, 1:-1] - x[:, :1], y[:, 1:-1] - y[:, :1]
     x2, y2 = x[:, 2:] - x[:, :1], y[:, 2:] - y[:, :1]
@@ -235,11 +248,25 @@ def _edges_of(s, keep_lo, N):
     return key[starts], np.r_[starts, key.size].astype(np.int64), tet
 
 
+def _whole_cgal(points, n_real):
+    """CGAL's triangulation, with the faces' polygons already in cyclic order."""
+    from .native import cgal_delaunay
+    N = points.shape[0]
+    s, vertices, pairs, counts, around = cgal_delaunay(points, n_real)
+    src_start = np.r_[0, np.cumsum(counts)].astype(np.int64)
+    order = np.argsort(pairs[:, 0] * N + pairs[:, 1])          # faces in key order, as qhull's
+    ln = counts[order]
+    ridge_start = np.r_[0, np.cumsum(ln)].astype(np.int64)
+    gather = np.repeat(src_start[order] - ridge_start[:-1], ln) + np.arange(ridge_start[-1])
+    t = Tessellation(points=points, vertices=vertices, simplices=s, ridge_points=pairs[order],
+                     ridge_start=ridge_start, ridge_vertex=around[gather], ordered=True)
+    return dataclasses.replace(t, geometry=t.face_geometry())
+
+
 def _whole(points, n_real, backend="qhull"):
     N = points.shape[0]
     if backend == "cgal":
-        from .native import cgal_delaunay
-        s, vertices = cgal_delaunay(points)
+        return _whole_cgal(points, n_real)
     else:
         tri = Delaunay(points)
         s = tri.simplices.astype(np.int64)

@@ -666,7 +666,8 @@ class VoronoiFaces:
         common neighbour), plus the bonds themselves."""
         b = np.sort(np.asarray(bonds, dtype=np.int64).reshape(-1, 2), axis=1)
         out = np.concatenate([self.pairs[self.linked(b, hops)], b])
-        return np.unique(out, axis=0)
+        key = np.unique(out[:, 0] * self.n + out[:, 1])  # np.unique(out, axis=0), by one int64 key
+        return np.column_stack([key // self.n, key % self.n])
 
     def cracked(self, pos, bonds, reference_bonds, hops: int = 3) -> np.ndarray:
         """The Voronoi pairs that conduct after the bonds ``reference_bonds - bonds`` broke, by
@@ -723,7 +724,8 @@ class VoronoiFaces:
                 cut[ci[inside]] = True
                 keep[cand[cut]] = False
         out = np.concatenate([self.pairs[keep], b])
-        return np.unique(out, axis=0)
+        key = np.unique(out[:, 0] * n + out[:, 1])      # np.unique(out, axis=0), by one int64 key
+        return np.column_stack([key // n, key % n])
 
 
 # ---------------------------------------------------------------------------------------

@@ -96,9 +96,11 @@ def delaunay_backend() -> str:
         return "qhull"
 
 
-def cgal_delaunay(points, tmpdir: Optional[str] = None):
-    """(cells (T, 4) int64, circumcentres (T, 3)) of the Delaunay triangulation of ``points``
-    (N, 3) by CGAL. Raises :class:`NativeError` if the helper fails or points coincide."""
+def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
+    """The Delaunay triangulation of ``points`` (N, 3) by CGAL, with its Voronoi faces:
+    (cells (T, 4) int64, circumcentres (T, 3), pairs (m, 2) of the Delaunay edges with a
+    point < ``n_real`` (i < j), counts (m,), the cells around each edge in cyclic order
+    (flat)). Raises :class:`NativeError` if the helper fails or points coincide."""
     exe = cgal_executable()
     P = np.ascontiguousarray(points, dtype=np.float64)
     with tempfile.TemporaryDirectory(dir=tmpdir, prefix="yade-electro-dt-") as d:
@@ -106,15 +108,18 @@ def cgal_delaunay(points, tmpdir: Optional[str] = None):
         with open(fin, "wb") as fh:
             np.array([P.shape[0]], np.int64).tofile(fh)
             P.tofile(fh)
-        r = subprocess.run([str(exe), fin, fout], capture_output=True, text=True)
+        r = subprocess.run([str(exe), fin, fout, str(int(n_real))], capture_output=True, text=True)
         if r.returncode == 3:
             raise NativeError("delaunay_cgal: some points coincide (CGAL keeps one of each)")
         if r.returncode != 0:
             raise NativeError(f"delaunay_cgal failed (exit {r.returncode}): {r.stderr.strip()[-500:]}")
         with open(fout, "rb") as fh:
-            nv, nc = (int(v) for v in np.fromfile(fh, np.int64, 2))
+            nv, nc, ne, ni = (int(v) for v in np.fromfile(fh, np.int64, 4))
             cells = np.fromfile(fh, np.int64, 4 * nc).reshape(nc, 4)
             cc = np.fromfile(fh, np.float64, 3 * nc).reshape(nc, 3)
-    if cells.shape[0] != nc or cc.shape[0] != nc:
+            pairs = np.fromfile(fh, np.int64, 2 * ne).reshape(ne, 2)
+            counts = np.fromfile(fh, np.int64, ne)
+            around = np.fromfile(fh, np.int64, ni)
+    if around.size != ni or counts.sum() != ni:
         raise NativeError("delaunay_cgal: short output")
-    return cells, cc
+    return cells, cc, pairs, counts, around
