@@ -33,7 +33,7 @@ def log(msg):
     print(f"[bench_petsc] {msg}", file=sys.stderr, flush=True)
 
 
-def worker(sizes, repeat):
+def worker(sizes):
     from bench_scale import RADIUS, jittered_rod, reduced_rod_system
     from yade_electro.conductance import conductance
     from yade_electro.petsc_solver import PETScSolver, import_petsc
@@ -77,7 +77,7 @@ def worker(sizes, repeat):
             print(json.dumps(row), flush=True)
 
 
-def run_worker(ranks, sizes, repeat):
+def run_worker(ranks, sizes):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     cmd = ["mpiexec", "-n", str(ranks), sys.executable, os.path.abspath(__file__), "--worker",
@@ -94,13 +94,13 @@ def main(argv=None):
     args = ap.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",")]
     if args.worker:
-        worker(sizes, args.repeat)
+        worker(sizes)
         return
     best = {}
     for k in range(args.repeat):
         for ranks in (1, 2):
             t = time.perf_counter()
-            for row in run_worker(ranks, sizes, args.repeat):
+            for row in run_worker(ranks, sizes):
                 key = (row["n"], ranks)
                 old = best.get(key)
                 if old is None:

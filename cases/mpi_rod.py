@@ -35,7 +35,7 @@ if os.path.dirname(HERE) not in sys.path:  # run from a checkout without install
     sys.path.insert(0, os.path.dirname(HERE))
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
-from rod_resistance import LENGTH, RADIUS, RHO_304L, end_layers  # noqa: E402
+from rod_resistance import RHO_304L, build_rod  # noqa: E402
 
 from yade_electro.yade.runtime import import_yade  # noqa: E402
 
@@ -60,21 +60,11 @@ def _solve(spec, law, solver, label):
 def run_mpi_rod(n=20000, seed=1, law="continuum", cache_dir=None):
     """Build the rod, solve it with 'petsc' (all ranks) and 'cg-deflated' (each rank); return
     the figures (the same on every rank)."""
-    from yade import pack
     from yade_electro.petsc_solver import import_petsc
-    from yade_electro.yade import packing as P
-    PETSc = import_petsc()
-    comm = PETSc.COMM_WORLD
-    yade = import_yade()
-    O = yade.Omega()
-    O.reset()
-    t0 = time.perf_counter()
-    container = pack.inCylinder((0, 0, 0), (0, 0, LENGTH), RADIUS)
-    packing = P.dense_packing(container, n=n, seed=seed, cache_dir=cache_dir)
-    ids = np.asarray(P.add_bonded_packing(packing))
-    t_pack = time.perf_counter() - t0
-    r_mean = float(np.mean(packing.radii))
-    bottom, top = end_layers(packing.centers[:, 2], packing.radii, r_mean)
+    comm = import_petsc().COMM_WORLD
+    rod = build_rod(n, seed, cache_dir=cache_dir)
+    ids, bottom, top = rod["ids"], rod["bottom"], rod["top"]
+    t_pack = rod["t_packing_s"] + rod["t_bonding_s"]
     spec = {"top": dict(select=ids[top], potential=1.0), "bottom": dict(select=ids[bottom], potential=0.0)}
     par = _solve(spec, law, "petsc", "rod_petsc")
     ser = _solve(spec, law, "cg-deflated", "rod_serial")

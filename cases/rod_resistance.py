@@ -74,6 +74,30 @@ def end_layers(z, r, r_mean, gap=0.1, length=LENGTH):
     return bottom, top
 
 
+def build_rod(n=5000, seed=1, gap=0.1, detection_factor=None, cache_dir=None):
+    """Reset YADE's scene and fill it with the bonded rod (the packing from the cache when it
+    is there). Returns a dict: container (YADE predicate), packing, ids (body ids), r_mean,
+    bottom and top (masks of the end layers, see :func:`end_layers`), t_packing_s (the
+    dense packing) and t_bonding_s. ``detection_factor`` None: add_bonded_packing's default."""
+    yade = import_yade()
+    from yade import pack
+    from yade_electro.yade import packing as P
+    O = yade.Omega()
+    O.reset()
+    t0 = time.perf_counter()
+    container = pack.inCylinder((0, 0, 0), (0, 0, LENGTH), RADIUS)
+    packing = P.dense_packing(container, n=n, seed=seed, cache_dir=cache_dir)
+    t_pack = time.perf_counter() - t0
+    kw = {} if detection_factor is None else {"detection_factor": detection_factor}
+    t1 = time.perf_counter()
+    ids = np.asarray(P.add_bonded_packing(packing, **kw))
+    t_bond = time.perf_counter() - t1
+    r_mean = float(np.mean(packing.radii))
+    bottom, top = end_layers(packing.centers[:, 2], packing.radii, r_mean, gap)
+    return {"container": container, "packing": packing, "ids": ids, "r_mean": r_mean, "bottom": bottom,
+            "top": top, "t_packing_s": t_pack, "t_bonding_s": t_bond}
+
+
 def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_params=None, solver="cg",
             gap=0.1, detection_factor=None, cache_dir=None, history=None, elements_csv=None, electrodes="layers"):
     """Build (or load from the cache) the bonded rod in YADE, solve it with the electrical
@@ -86,27 +110,19 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     if electrodes == "surface" and law != "voronoi":
         raise ValueError("surface electrodes need the 'voronoi' law (its cells give the end faces): --law voronoi")
     yade = import_yade()
-    from yade import pack
     from yade_electro.yade import ElectricalEngine
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
-    O.reset()
-    t0 = time.perf_counter()
-    container = pack.inCylinder((0, 0, 0), (0, 0, LENGTH), RADIUS)
-    packing = P.dense_packing(container, n=n, seed=seed, cache_dir=cache_dir)
-    t_pack = time.perf_counter() - t0
-    if law == "voronoi":
-        law_params = {"container": P.as_shape(container), **(law_params or {})}
     if detection_factor is None:
         import inspect
         detection_factor = inspect.signature(P.add_bonded_packing).parameters["detection_factor"].default
-    kw = {"detection_factor": detection_factor}
-    ids = P.add_bonded_packing(packing, **kw)
-    r_mean = float(np.mean(packing.radii))
-    z, r = packing.centers[:, 2], packing.radii
-    bottom, top = end_layers(z, r, r_mean, gap)
-    ids = np.asarray(ids)
+    built = build_rod(n, seed, gap, detection_factor, cache_dir)
+    container, packing, ids, r_mean = built["container"], built["packing"], built["ids"], built["r_mean"]
+    bottom, top, t_pack = built["bottom"], built["top"], built["t_packing_s"]
+    r = packing.radii
+    if law == "voronoi":
+        law_params = {"container": P.as_shape(container), **(law_params or {})}
     if electrodes == "surface":
         rod = P.as_shape(container)
         spec = {"top": dict(surface=rod.face("top"), potential=voltage),

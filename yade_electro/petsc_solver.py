@@ -34,6 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import SolverError
+from .solvers import Solver
 
 __all__ = ["PETScSolver", "import_petsc", "petsc_available"]
 
@@ -77,7 +78,7 @@ def petsc_available() -> bool:
         return False
 
 
-class PETScSolver:
+class PETScSolver(Solver):
     """CG preconditioned by PETSc's algebraic multigrid (GAMG, smoothed aggregation), on
     ``comm`` (default ``PETSc.COMM_WORLD``); see the module doc.
 
@@ -105,14 +106,11 @@ class PETScSolver:
             raise ValueError(f"rtol must be in (0, 1), got {rtol}")
         if preconditioner not in ("gamg", "jacobi", "none"):
             raise ValueError(f"preconditioner must be 'gamg', 'jacobi' or 'none', got {preconditioner!r}")
+        super().__init__()
         self.PETSc = import_petsc()
         self.comm = self.PETSc.COMM_WORLD if comm is None else comm
         self.rtol, self.maxiter, self.preconditioner = float(rtol), maxiter, preconditioner
         self.options = dict(options or {})
-        self._A = None
-        self.setup_time = 0.0
-        self.n_setups = 0
-        self.n_updates = 0
 
     @property
     def size(self) -> int:
@@ -122,9 +120,6 @@ class PETScSolver:
     @property
     def rank(self) -> int:
         return self.comm.getRank()
-
-    def set_geometry(self, coords, spacing=None):
-        """Ignored (GAMG builds its coarse spaces from the matrix)."""
 
     # -- setup -------------------------------------------------------------------------------
     def _local_csr(self, A):
@@ -167,23 +162,8 @@ class PETScSolver:
         self._ksp = ksp
         self._scatter, self._xall = PETSc.Scatter.toAll(self._x)
 
-    def _ensure_setup(self, A) -> bool:
-        if A is not self._A:
-            t = time.perf_counter()
-            self._setup(A)
-            self._A = A
-            self.setup_time = time.perf_counter() - t
-            self.n_setups += 1
-            return True
-        return False
-
-    def update(self, A):
-        """The values of ``A`` (the kept matrix object) changed in place, same pattern: new
-        values into PETSc's matrix, GAMG's interpolation kept."""
-        if A is not self._A:
-            self._A = None
-            return
-        self.n_updates += 1
+    def _update(self, A):
+        """New values (same pattern) into PETSc's matrix, GAMG's interpolation kept."""
         ip, ix, v = self._local_csr(self._Acsr)
         self._M.setValuesCSR(ip, ix, v)
         self._M.assemble()

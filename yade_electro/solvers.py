@@ -61,7 +61,7 @@ from .threads import apply_default_limit
 # OpenBLAS to one thread (YADE_ELECTRO_BLAS_THREADS, default 1): see yade_electro.threads
 apply_default_limit()
 
-__all__ = ["make_solver", "solver_names", "auto_solver_name", "CGSolver", "DeflatedCGSolver", "AMGSolver",
+__all__ = ["make_solver", "solver_names", "auto_solver_name", "Solver", "CGSolver", "DeflatedCGSolver", "AMGSolver",
            "DirectSolver", "AUTO_DEFLATION_FROM"]
 
 log = logging.getLogger(__name__)
@@ -83,7 +83,11 @@ def _residual(A, x, b):
     return r / nb if nb > 0 else r
 
 
-class _Solver:
+class Solver:
+    """Base of the solvers: keeps the setup while it is given the same matrix object, counts
+    setups and value updates (see module doc). Subclasses define ``_setup(A)``, optionally
+    ``_update(A)`` (default: a full setup), and ``solve``."""
+
     name = "?"
 
     def __init__(self):
@@ -121,7 +125,7 @@ class _Solver:
         raise NotImplementedError
 
 
-class DirectSolver(_Solver):
+class DirectSolver(Solver):
     """Sparse LU (SuperLU, COLAMD ordering), kept while the matrix is unchanged and redone on
     ``update``. Exact to rounding."""
 
@@ -191,7 +195,7 @@ def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
     return x, it, res
 
 
-class CGSolver(_Solver):
+class CGSolver(Solver):
     """Jacobi-preconditioned conjugate gradient (the paper's choice) for SPD systems.
 
     Parameters

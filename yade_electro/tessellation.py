@@ -273,11 +273,10 @@ def _whole(points, n_real, backend="qhull"):
     N = points.shape[0]
     if backend == "cgal":
         return _whole_cgal(points, n_real)
-    else:
-        tri = Delaunay(points)
-        s = tri.simplices.astype(np.int64)
-        vertices = circumcentres(points, s, tri.neighbors)
-        del tri
+    tri = Delaunay(points)
+    s = tri.simplices.astype(np.int64)
+    vertices = circumcentres(points, s, tri.neighbors)
+    del tri
     ukey, ridge_start, tet = _edges_of(s, lambda lo: lo < n_real, N)
     t = Tessellation(points=points, vertices=vertices, simplices=s,
                      ridge_points=np.column_stack([ukey // N, ukey % N]), ridge_start=ridge_start, ridge_vertex=tet)

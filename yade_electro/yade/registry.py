@@ -121,11 +121,11 @@ def attach(label: Optional[str] = None, O=None, **overrides):
 
 def run(label: str):
     """The PyRunner entry point: one step of the engine ``label`` (re-attached if needed)."""
-    from .engines import MPY_REFUSAL, in_mpy_subdomain
-    if in_mpy_subdomain():                 # before any re-attach reads a subdomain's bodies
-        raise RuntimeError(MPY_REFUSAL.format(label=label))
     engine = ENGINES.get(label)
     if engine is None or engine.removed:
+        from .engines import MPY_REFUSAL, in_mpy_subdomain
+        if in_mpy_subdomain():             # before a re-attach reads a subdomain's bodies
+            raise RuntimeError(MPY_REFUSAL.format(label=label))
         from .runtime import import_yade
         O = import_yade().Omega()
         if persistence.load_config(O, label) is None:
