@@ -133,3 +133,18 @@ def test_backend_setting(monkeypatch):
     monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "fast")
     with pytest.raises(ValueError, match="'auto', 'cgal' or 'qhull'"):
         delaunay_backend()
+
+
+def test_without_cgal_auto_falls_back_and_cgal_says_why(monkeypatch):
+    import yade_electro.native as native
+    monkeypatch.setattr(native, "CGAL_HEADER", native.Path("/nonexistent/CGAL/Delaunay_triangulation_3.h"))
+    monkeypatch.setattr(native, "_CGAL", {})                     # no cached executable
+    monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "auto")
+    assert native.delaunay_backend() == "qhull"
+    monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "cgal")
+    with pytest.raises(native.NativeError, match="apt-get install libcgal-dev"):
+        native.delaunay_backend()
+    pts, n = _cloud(500, 4)
+    monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "auto")
+    t = tessellate(pts, n)                                          # qhull, no error
+    assert t.n_ridges > 0 and not t.ordered
