@@ -28,14 +28,32 @@ so its overlap is 2^(1/3) times the Hertz one and R_plate comes out 0.88 % below
 value; against the contact YADE actually makes (``R_plate_yade``, R* = r / 2) it agrees to
 1e-5 %.
 
-Not here yet: a random packing pressed between two plates.
+The random packing (``--random N``, default 400): N steel spheres (r = 1 mm +- 15 %) from a
+loose cloud in a square box of side 6 d, frictionless side walls, between the plate and a lid
+(both ``Wall``s, both electrodes). The lid is free along z only and carries a permanent force
+F; there is no gravity, so at equilibrium the plate carries F too. At each F (ascending, 1 to
+100 N) the bed is relaxed until the plate's reaction and the lid's contact force are F to
+``RANDOM_TOL`` and YADE's unbalanced force is below it; then R between lid and plate. There is
+no closed form. Two figures are reported:
+
+* ``R_check`` (``R_check_error_pct``): the same network built here from YADE's own contact
+  *forces*, a_c = (3 f_c R*_c / (4 E*))^(1/3) between spheres (Hertz) and a_w = sqrt(r delta_w)
+  on the walls with delta_w from the force on YADE's wall contact (R* = r / 2, see above),
+  conductance 2 a / rho_e, solved with SciPy's sparse LU: the engine reads overlaps, this reads
+  forces, and they must agree;
+* ``slope_random``: log R against log F. A fixed set of contacts whose forces all scale with F
+  gives exactly -1/3; a random packing departs from it because contacts are made as it is
+  pressed and the forces redistribute. ``slope_fixed_contacts`` is the slope of the network of
+  the contacts present at the smallest F only (their radii at each F): the difference from
+  ``slope_random`` is what the new contacts do.
 
 Run
 ---
-    yade-electro -n -x cases/powder_column.py [--n 10]
+    yade-electro -n -x cases/powder_column.py [--n 10] [--random 400]  (--random 0: the column only)
 
 Ends with one JSON line: ``{"case": "powder_column", "slope": ..., "slope_error_pct": ...,
-"max_R_error_pct": ..., ...}`` (``slope``: the ``hertz`` radius model).
+"max_R_error_pct": ..., "slope_random": ..., ...}`` (``slope``: the column, ``hertz`` radius
+model).
 """
 from __future__ import annotations
 
@@ -43,6 +61,8 @@ import argparse
 import json
 import os
 import sys
+import time
+import warnings
 
 import numpy as np
 
@@ -176,6 +196,205 @@ def run(n=10, forces=FORCES, progress=print):
     return out
 
 
+RANDOM_N = 400                          # spheres of the random packing
+RANDOM_FORCES = tuple(np.logspace(0, 2, 5))   # N on the lid
+RANDOM_TOL = 1e-3                       # relative force balance of the relaxed bed
+RANDOM_R_TOL = 1e-4                     # relative change of R over a chunk of steps, relaxed
+
+
+def build_random(n=RANDOM_N, seed=1, width_d=6.0, height_d=10.0, progress=print):
+    """Reset YADE: plate, four frictionless sides, a lid free along z, and ``n`` steel spheres
+    placed densely in the box between them (the project's ``dense_packing``: no overlaps, touching
+    the walls; radii +- 12.5 %). Returns dict(spheres, plate, lid, sides, width [m])."""
+    from yade_electro.geometry import Box
+    from yade_electro.packing import dense_packing
+    from yade_electro.yade.runtime import import_yade
+    yade = import_yade()
+    from yade import utils
+    from yade import wrapper as W
+    O = yade.Omega()
+    O.reset()
+    r = RADIUS
+    t0 = time.time()
+    width = width_d * 2 * r
+    h = width / 2
+    # the box's height for n spheres of mean radius r at the placement's usual fraction
+    height = n * 4.0 / 3.0 * np.pi * r ** 3 / 0.6 / width ** 2
+    pk = dense_packing(Box((-h, -h, 0.0), (h, h, height)), n=n, dispersion=0.25, seed=seed)
+    progress(f"random packing: {len(pk.radii)} spheres placed at a volume fraction {pk.volume_fraction:.3f} "
+             f"({time.time() - t0:.0f} s)")
+    mat = O.materials.append(W.FrictMat(young=YOUNG, poisson=POISSON, density=DENSITY, frictionAngle=0.3))
+    smooth = O.materials.append(W.FrictMat(young=YOUNG, poisson=POISSON, density=DENSITY, frictionAngle=0.0))
+    plate = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
+    sides = O.bodies.append([utils.wall(-h, axis=0, sense=1, material=smooth), utils.wall(h, axis=0, sense=-1,
+                             material=smooth), utils.wall(-h, axis=1, sense=1, material=smooth),
+                             utils.wall(h, axis=1, sense=-1, material=smooth)])
+    spheres = O.bodies.append([utils.sphere(tuple(c), float(rad), material=mat)
+                               for c, rad in zip(pk.centers, pk.radii)])
+    top = max(O.bodies[i].state.pos[2] + O.bodies[i].shape.radius for i in spheres)
+    lid = O.bodies.append(utils.wall(top, axis=2, sense=-1, material=mat))
+    b = O.bodies[lid]
+    b.dynamic = True
+    b.state.blockedDOFs = "xyXYZ"
+    b.state.mass = sum(O.bodies[i].state.mass for i in spheres)     # the bed's mass
+    # viscous contact damping (betan, betas) takes the energy of the rearrangements out; it
+    # adds no force at rest, so the relaxed contact forces are Hertz-Mindlin's
+    O.engines = [W.ForceResetter(), W.InsertionSortCollider([W.Bo1_Sphere_Aabb(), W.Bo1_Wall_Aabb()]),
+                 W.InteractionLoop([W.Ig2_Sphere_Sphere_ScGeom(), W.Ig2_Wall_Sphere_ScGeom()],
+                                   [W.Ip2_FrictMat_FrictMat_MindlinPhys(betan=0.5, betas=0.5)],
+                                   [W.Law2_ScGeom_MindlinPhys_Mindlin()]),
+                 W.NewtonIntegrator(damping=0.7, gravity=(0, 0, 0))]
+    O.dt = 0.3 * utils.PWaveTimeStep()
+    return {"spheres": list(spheres), "plate": plate, "lid": lid, "sides": list(sides), "width": width}
+
+
+def _wall_force(O, wall):
+    """Sum of the normal forces [N] of the real contacts on ``wall``."""
+    f = 0.0
+    for i in O.interactions.withBody(wall):
+        if i.isReal:
+            f += abs(i.phys.normalForce[2])
+    return f
+
+
+def relax_random(O, ids, F, measure, tol=RANDOM_TOL, r_tol=RANDOM_R_TOL, chunk=10_000, max_steps=3_000_000,
+                 progress=print):
+    """Put F [N] on the lid and run until the plate's reaction and the lid's contacts carry F to
+    ``tol`` and the resistance ``measure()`` [ohm] changes by less than ``r_tol`` over a chunk of
+    steps. YADE's unbalanced force is no criterion here: the rattlers (spheres held by one or two
+    weak contacts, free to drift without gravity) keep it near 1e-2 long after the loaded
+    skeleton has settled. Returns (steps, R, unbalanced force)."""
+    from yade import utils
+    O.forces.setPermF(ids["lid"], (0, 0, -float(F)))
+    steps, t0, R_prev, R = 0, time.time(), None, None
+    while steps < max_steps:
+        O.run(chunk, True)
+        steps += chunk
+        fp, fl = _wall_force(O, ids["plate"]), _wall_force(O, ids["lid"])
+        balanced = abs(fp / F - 1) < tol and abs(fl / F - 1) < tol
+        R = measure() if balanced else None
+        if R is not None and R_prev is not None and abs(R / R_prev - 1) < r_tol:
+            return steps, R, float(utils.unbalancedForce())
+        R_prev = R
+        if steps % (10 * chunk) == 0:
+            progress(f"  F = {F:.3g} N: {steps} steps, plate {fp:.5g} N, lid {fl:.5g} N, R {R} "
+                     f"({time.time() - t0:.0f} s)")
+    raise RuntimeError(f"the random packing did not settle under {F} N within {max_steps} steps "
+                       f"(plate {fp:.4g} N, lid {fl:.4g} N, R {R_prev} then {R})")
+
+
+def _network_from_forces(O, ids, keep=None):
+    """The lid-plate resistance [ohm] of the contact network built from YADE's contact forces
+    (see the module doc), and the contacts used as (id1, id2) pairs. ``keep``: only these pairs."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    Es = effective_modulus()
+    lid, plate = ids["lid"], ids["plate"]
+    walls = {lid: 0, plate: 1}
+    pairs, g = [], []
+    for i in O.interactions:
+        if not i.isReal:
+            continue
+        a, b = i.id1, i.id2
+        fn = float(i.phys.normalForce.norm())
+        if fn <= 0:
+            continue
+        if a in walls or b in walls:
+            w, s = (a, b) if a in walls else (b, a)
+            if w not in walls:
+                continue
+            r = O.bodies[s].shape.radius
+            # YADE's wall contact: R* = r / 2 (see the module doc), delta from its force
+            delta = (3.0 * fn / (4.0 * Es * np.sqrt(r / 2.0))) ** (2.0 / 3.0)
+            rad = np.sqrt(r * delta)
+        elif not (O.bodies[a].shape.__class__.__name__ == "Sphere" and O.bodies[b].shape.__class__.__name__ == "Sphere"):
+            continue
+        else:
+            r1, r2 = O.bodies[a].shape.radius, O.bodies[b].shape.radius
+            rad = (3.0 * fn * (r1 * r2 / (r1 + r2)) / (4.0 * Es)) ** (1.0 / 3.0)
+        key = (min(a, b), max(a, b))
+        if keep is not None and key not in keep:
+            continue
+        pairs.append(key)
+        g.append(2.0 * rad / RESISTIVITY)
+    nodes = sorted({k for p in pairs for k in p} - set(walls))
+    index = {b: k + 2 for k, b in enumerate(nodes)}
+    index.update(walls)
+    n = len(nodes) + 2
+    ii = np.array([index[p[0]] for p in pairs])
+    jj = np.array([index[p[1]] for p in pairs])
+    g = np.array(g)
+    L = sp.coo_matrix((np.concatenate([-g, -g, g, g]), (np.concatenate([ii, jj, ii, jj]),
+                       np.concatenate([jj, ii, ii, jj]))), shape=(n, n)).tocsr()
+    # lid (node 0) at 1 V, plate (node 1) at 0 V; unknowns: the spheres of their connected part
+    from scipy.sparse.csgraph import connected_components
+    _, lab = connected_components(L, directed=False)
+    live = np.flatnonzero(lab == lab[0])
+    live = live[live >= 2]
+    if lab[0] != lab[1] or live.size == 0:
+        return float("inf"), set(pairs)
+    Luu = L[live][:, live].tocsc()
+    rhs = -L[live][:, [0]].toarray().ravel()
+    phi = spla.splu(Luu).solve(rhs)
+    current = float(L[0, 0] * 1.0 + L[0][:, live] @ phi)
+    return 1.0 / current, set(pairs)
+
+
+def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
+    """The random packing pressed between plate and lid; returns the figures."""
+    from yade_electro.yade.runtime import import_yade
+    O = import_yade().Omega()
+    from yade_electro.yade import ElectricalEngine
+    t0 = time.time()
+    ids = build_random(n, seed, progress=progress)
+    engine = None
+    rows, first = [], None
+
+    def measure():
+        nonlocal engine
+        if engine is None:            # made once the bed carries the lid: its contacts exist
+            engine = ElectricalEngine(RESISTIVITY, {"lid": dict(wall=ids["lid"], potential=1.0),
+                                                    "plate": dict(wall=ids["plate"], potential=0.0)},
+                                      law="contact", law_params=dict(radius="hertz"), bonds="contacts",
+                                      iterPeriod=10 ** 9, geometry_every=1, move_tolerance=1e-12, write_back=None,
+                                      label="random_column")
+        engine.step()
+        return float(engine.equivalent_resistance)
+
+    for F in forces:
+        with warnings.catch_warnings():       # the rattlers (no contact, or none to a wall's part)
+            warnings.filterwarnings("ignore", message=".*connected to no electrode")
+            steps, R, unbalanced = relax_random(O, ids, F, measure, progress=progress)
+        plate_force = _wall_force(O, ids["plate"])
+        R_check, pairs = _network_from_forces(O, ids)
+        if first is None:
+            first = pairs
+        R_fixed, _ = _network_from_forces(O, ids, keep=first)
+        sph = set(ids["spheres"])
+        n_sph = sum(1 for p in pairs if p[0] in sph and p[1] in sph)
+        loaded = {b for p in pairs for b in p if b in sph}
+        lid_z = float(O.bodies[ids["lid"]].state.pos[2])
+        phi = sum(4.0 / 3.0 * np.pi * O.bodies[i].shape.radius ** 3 for i in ids["spheres"]) / (ids["width"] ** 2 * lid_z)
+        row = {"F": float(F), "steps": int(steps), "plate_force_error": plate_force / F - 1.0,
+               "unbalanced_force": unbalanced, "R": R, "R_check": R_check,
+               "R_check_error_pct": 100.0 * (R / R_check - 1.0), "R_fixed_contacts": R_fixed,
+               "contacts": len(pairs), "sphere_contacts": n_sph, "loaded_spheres": len(loaded),
+               "coordination": 2.0 * n_sph / max(len(loaded), 1), "solid_fraction": phi, "height_m": lid_z,
+               "floating_spheres": int(np.sum(engine.solution.floating))}
+        rows.append(row)
+        progress(f"random packing, F = {F:7.3f} N: R {R:.5e} ohm (network of YADE's forces {R_check:.5e}, "
+                 f"{row['R_check_error_pct']:+.2e} %), {len(pairs)} contacts, Z = {row['coordination']:.2f}, "
+                 f"phi = {phi:.3f}, {steps} steps ({time.time() - t0:.0f} s)")
+    engine.remove()
+    logF = np.log([r["F"] for r in rows])
+    slope = float(np.polyfit(logF, np.log([r["R"] for r in rows]), 1)[0])
+    slope_fixed = float(np.polyfit(logF, np.log([r["R_fixed_contacts"] for r in rows]), 1)[0])
+    return {"random_n": n, "random_seed": seed, "slope_random": slope,
+            "slope_random_vs_chain_pct": 100.0 * (slope / (-1.0 / 3.0) - 1.0), "slope_fixed_contacts": slope_fixed,
+            "max_R_check_error_pct": float(max(abs(r["R_check_error_pct"]) for r in rows)),
+            "random_s": round(time.time() - t0, 1), "rows": rows}
+
+
 def plot(out, path):
     import matplotlib
     matplotlib.use("Agg")
@@ -188,9 +407,13 @@ def plot(out, path):
     for m, mk, what in (("hertz", "o", "hertz radius"), ("geometric", "s", "geometric radius"),
                         ("plate", "^", "to the plate, hertz")):
         ax.loglog(F, [r[f"R_{m}"] for r in out["rows"]], mk, label=f"DEM, {what}: slope {out[f'slope_{m}']:.4f}")
+    if out.get("random_rows"):
+        rr = out["random_rows"]
+        ax.loglog([r["F"] for r in rr], [r["R"] for r in rr], "D-", label=f"random packing of {out['random_n']}, lid to "
+                  f"plate: slope {out['slope_random']:.4f}")
     ax.set_xlabel("F [N]")
     ax.set_ylabel("R [ohm]")
-    ax.set_title(f"{out['n']} spheres in a column")
+    ax.set_title(f"{out['n']} spheres in a column" + (", and a random packing" if out.get("random_rows") else ""))
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -201,17 +424,27 @@ def plot(out, path):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, default=10)
+    ap.add_argument("--random", type=int, default=RANDOM_N, help="spheres of the random packing (0: none)")
+    ap.add_argument("--seed", type=int, default=1, help="seed of the random packing's cloud")
     ap.add_argument("--out", default="out/powder_column")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from caselib import apply_batch_table
-    args = apply_batch_table(args, columns=("n",))
+    args = apply_batch_table(args, columns=("n", "random"))
     os.makedirs(args.out, exist_ok=True)
     out = run(args.n)
+    if args.random:
+        rnd = run_random(args.random, seed=args.seed)
+        out.update({k: v for k, v in rnd.items() if k != "rows"})
+        out["random_rows"] = rnd["rows"]
     out["png"] = plot(out, os.path.join(args.out, f"powder_column_n{args.n}.png"))
     with open(os.path.join(args.out, f"powder_column_n{args.n}.json"), "w") as fh:
         json.dump(out, fh)
     print(f"column of {args.n} spheres: slope {out['slope']:.5f} ({out['slope_error_pct']:+.3f} % from -1/3), R within "
           f"{out['max_R_error_pct']:.4f} % of the exact chain; geometric radius: slope {out['slope_geometric']:.5f}")
+    if args.random:
+        print(f"random packing of {out['random_n']} spheres: slope {out['slope_random']:.4f} "
+              f"(fixed contacts {out['slope_fixed_contacts']:.4f}), engine against the network of YADE's forces "
+              f"within {out['max_R_check_error_pct']:.2e} %")
     print(json.dumps(out))
     return out
 

@@ -1,7 +1,8 @@
 """The pressed column (cases/powder_column.py) in the real YADE: Hertz-Mindlin contacts, the
 contact law with the Hertz radius gives the exact chain resistance (measured 1e-5 %) and the
-slope -1/3 of log R against log F (6e-6 %); the geometric radius about 1/sqrt(2) of R. And the
-contact-radius models on a pair with exact answers (numpy only)."""
+slope -1/3 of log R against log F (6e-6 %); the geometric radius about 1/sqrt(2) of R; a random
+packing pressed between plate and lid, whose R is the network's of YADE's contact forces. And
+the contact-radius models on a pair with exact answers (numpy only)."""
 import math
 import os
 import sys
@@ -28,7 +29,7 @@ def test_contact_radius_models():
 
 @pytest.mark.yade
 def test_column_follows_the_hertz_chain(run_yade_script, tmp_path):
-    row = run_yade_script(CASE, "--n", "6", "--out", str(tmp_path), timeout=600, check=True).result
+    row = run_yade_script(CASE, "--n", "6", "--random", "60", "--out", str(tmp_path), timeout=900, check=True).result
     assert row["case"] == "powder_column" and row["contacts"] == 5
     assert abs(row["slope_error_pct"]) < 1.0                 # the issue's target
     assert abs(row["slope_error_pct"]) < 1e-3 and row["max_R_error_pct"] < 1e-3
@@ -45,3 +46,14 @@ def test_column_follows_the_hertz_chain(run_yade_script, tmp_path):
     w = 2 ** (-1 / 3)                   # the plate contact's resistance over a sphere-sphere one
     share = w / (row["n"] - 1 + w)
     assert row["max_R_error_pct_plate"] == pytest.approx(100 * share * (1 - 2 ** (-1 / 6)), rel=1e-3)
+    # the random packing between plate and lid: the engine's R (from the overlaps) is the R of
+    # the network built from YADE's contact forces with Hertz's law, solved by SciPy
+    assert row["random_n"] == 60
+    rr = row["random_rows"]
+    assert len(rr) == 5 and row["max_R_check_error_pct"] < 0.1
+    assert all(a["R"] > b["R"] for a, b in zip(rr, rr[1:]))          # pressed harder, conducts better
+    assert all(abs(r["plate_force_error"]) < 1e-3 for r in rr)
+    # the contacts of the smallest force alone scale nearly as a chain; the contacts made on the way
+    # make the packing's slope steeper
+    assert abs(row["slope_fixed_contacts"] + 1 / 3) < 0.03
+    assert row["slope_random"] < row["slope_fixed_contacts"] < -0.3
