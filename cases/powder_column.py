@@ -28,13 +28,14 @@ so its overlap is 2^(1/3) times the Hertz one and R_plate comes out 0.88 % below
 value; against the contact YADE actually makes (``R_plate_yade``, R* = r / 2) it agrees to
 1e-5 %.
 
-The random packing (``--random N``, default 400): N steel spheres (r = 1 mm +- 15 %) from a
-loose cloud in a square box of side 6 d, frictionless side walls, between the plate and a lid
-(both ``Wall``s, both electrodes). The lid is free along z only and carries a permanent force
-F; there is no gravity, so at equilibrium the plate carries F too. At each F (ascending, 1 to
-100 N) the bed is relaxed until the plate's reaction and the lid's contact force are F to
-``RANDOM_TOL`` and YADE's unbalanced force is below it; then R between lid and plate. There is
-no closed form. Two figures are reported:
+The random packing (``--random N``, default 400): N steel spheres (r = 1 mm +- 12.5 %)
+placed by ``dense_packing`` in a square box of side 6 d, frictionless side walls, between the
+plate and a lid (both ``Wall``s, both electrodes). The lid is free along z only and carries a
+permanent force F; there is no gravity, so at equilibrium the plate carries F too. At each F
+(ascending, 1 to 100 N) the bed is relaxed until the plate's reaction and the lid's contact
+force are F to ``RANDOM_TOL`` and R between lid and plate changes by less than
+``RANDOM_R_TOL`` over a chunk of steps (see :func:`relax_random`). There is no closed form.
+Two figures are reported:
 
 * ``R_check`` (``R_check_error_pct``): the same network built here from YADE's own contact
   *forces*, a_c = (3 f_c R*_c / (4 E*))^(1/3) between spheres (Hertz) and a_w = sqrt(r delta_w)
@@ -262,7 +263,7 @@ def relax_random(O, ids, F, measure, tol=RANDOM_TOL, r_tol=RANDOM_R_TOL, chunk=1
     """Put F [N] on the lid and run until the plate's reaction and the lid's contacts carry F to
     ``tol`` and the resistance ``measure()`` [ohm] changes by less than ``r_tol`` over a chunk of
     steps. YADE's unbalanced force is no criterion here: the rattlers (spheres held by one or two
-    weak contacts, free to drift without gravity) keep it near 1e-2 long after the loaded
+    weak contacts, free to drift without gravity) keep it at 2e-3 to 1e-2 (400 and 100 spheres) after the loaded
     skeleton has settled. Returns (steps, R, unbalanced force)."""
     from yade import utils
     O.forces.setPermF(ids["lid"], (0, 0, -float(F)))
@@ -300,9 +301,7 @@ def _network_from_forces(O, ids, keep=None):
         if fn <= 0:
             continue
         if a in walls or b in walls:
-            w, s = (a, b) if a in walls else (b, a)
-            if w not in walls:
-                continue
+            s = b if a in walls else a
             r = O.bodies[s].shape.radius
             # YADE's wall contact: R* = r / 2 (see the module doc), delta from its force
             delta = (3.0 * fn / (4.0 * Es * np.sqrt(r / 2.0))) ** (2.0 / 3.0)
