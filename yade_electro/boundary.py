@@ -8,10 +8,12 @@ boundary condition acts on the boundary faces a surface selector picks
 
 * an electrode (or a fixed temperature) at a surface connects each element with faces on it
   through the *half-cell* conductance: the finite-volume Dirichlet condition,
-  ``sum_f A_f / (rho d_f)`` with ``d_f`` the distance from the element's centre to the face's
-  plane (exact for a uniform field across the surface);
+  ``sum_f A_f / (rho L_f)`` with ``L_f`` the distance d_f from the element's centre to the
+  face's plane (exact for a uniform field across a flat surface), corrected for the wall's
+  curvature kappa = k1 + k2 (:func:`half_cell_length`: L = -ln(1 - kappa d) / kappa, exact
+  across a cylindrical wall);
 * a heat flux acts on the faces' areas; convection acts on them in series with the half cell:
-  ``sum_f A_f / (1/h + d_f/lambda)``.
+  ``sum_f A_f / (1/h + L_f/lambda)``.
 
 :class:`SurfaceContact` holds, per element touched, the area and the geometric factor
 ``g = sum_f A_f / d_f`` [m] of a surface; :func:`boundary_areas` gives every element's
@@ -28,7 +30,7 @@ import numpy as np
 from .errors import BoundaryConditionError
 from .geometry import as_surface
 
-__all__ = ["SurfaceContact", "surface_contact", "SavedSurface", "SurfaceMembership", "check_surface", "boundary_areas",
+__all__ = ["SurfaceContact", "surface_contact", "half_cell_length", "SavedSurface", "SurfaceMembership", "check_surface", "boundary_areas",
            "BoundaryOfGraph"]
 
 
@@ -41,9 +43,11 @@ class SurfaceContact:
     name : str
     nodes : (k,) element indices (of the graph the cells were made for), unique, sorted
     area : (k,) boundary-face area of each on the surface [m^2]
-    factor : (k,) half-cell geometric factor sum_f A_f / d_f [m]
+    factor : (k,) half-cell geometric factor sum_f A_f / L_f [m]
     depth : (k,) area-weighted distance from the centre to the surface [m]
-    face_area, face_depth : (f,) each boundary face's area [m^2] and distance d_f [m]
+    face_area, face_depth : (f,) each boundary face's area [m^2] and half-cell length L_f [m]
+        (the distance d_f from the centre to the face, corrected for the wall's curvature
+        when the container was known: :func:`half_cell_length`)
     face_slot : (f,) the position in ``nodes`` of each face's element
     """
 
@@ -61,7 +65,7 @@ class SurfaceContact:
         return float(self.area.sum())
 
     def convection_area(self, h, conductivity) -> np.ndarray:
-        """Per element, the area A_eff [m^2] with h A_eff = sum_f A_f / (1/h + d_f / lambda):
+        """Per element, the area A_eff [m^2] with h A_eff = sum_f A_f / (1/h + L_f / lambda):
         convection ``h`` [W/(m^2 K)] in series with the half cell (``conductivity`` lambda
         [W/(m K)], a scalar or one per element of the graph)."""
         lam = np.asarray(conductivity, float)
@@ -84,10 +88,36 @@ class SurfaceContact:
                               new_slot[self.face_slot[f]])
 
 
-def surface_contact(cells, pos, surface, name: str = "surface", what: str = "electrode") -> SurfaceContact:
+#: bounds of kappa d in the curvature correction (beyond them the wall bends on the scale of
+#: the cell itself, where no local correction holds)
+CURVATURE_LIMITS = (-1.0, 0.5)
+
+
+def half_cell_length(depth, curvature):
+    """Effective length L [m] of a half cell of depth ``depth`` [m] under a wall of curvature
+    sum ``curvature`` k1 + k2 [1/m] (> 0 convex seen from the solid, < 0 concave), so that
+    its conductance is A / (rho L) with A the face's area on the wall.
+
+    Across a curved wall the current spreads (concave wall) or gathers (convex): the
+    parallel surfaces at depth s under the wall have areas A (1 - kappa s + ...), and the
+    resistance of the half cell is rho/A int_0^d ds / (1 - kappa s), so
+    ``L = -ln(1 - kappa d) / kappa``: exact for a cylindrical wall (a ln(1 + d/a) under a
+    hole of radius a, R ln(R / (R - d)) under a rod's side), d + d^2/R to second order under
+    a sphere, d on a plane. kappa d is held within ``CURVATURE_LIMITS``."""
+    d = np.asarray(depth, float)
+    x = np.clip(np.asarray(curvature, float) * d, *CURVATURE_LIMITS)
+    small = np.abs(x) < 1e-8
+    ratio = np.where(small, 1.0 + 0.5 * x, -np.log1p(-np.where(small, 0.0, x)) / np.where(small, 1.0, x))
+    return d * ratio
+
+
+def surface_contact(cells, pos, surface, name: str = "surface", what: str = "electrode",
+                    container=None) -> SurfaceContact:
     """The elements of ``cells`` (BoundedCells of the elements at ``pos``) whose boundary faces
     lie on ``surface`` (see :func:`yade_electro.geometry.as_surface`); raises
-    BoundaryConditionError when it touches none."""
+    BoundaryConditionError when it touches none. With the ``container`` (a Shape), each
+    face's half cell is corrected for the wall's curvature there (:func:`half_cell_length`);
+    without it the wall is taken as flat."""
     sel = as_surface(surface)
     pos = np.asarray(pos, float)
     on = np.asarray(sel(cells.boundary_point, cells.boundary_normal), bool)
@@ -101,12 +131,15 @@ def surface_contact(cells, pos, surface, name: str = "surface", what: str = "ele
     d = np.abs(np.einsum("ij,ij->i", cells.boundary_point[on] - pos[owner], cells.boundary_normal[on]))
     # an element centred on the surface itself: a thin half cell, never a zero one
     d = np.maximum(d, 1e-3 * np.sqrt(area))
+    length = d
+    if container is not None and hasattr(container, "wall_curvature"):
+        length = half_cell_length(d, container.wall_curvature(cells.boundary_point[on]))
     nodes = np.unique(owner)
     k = np.searchsorted(nodes, owner)
     A = np.bincount(k, area, nodes.size)
-    g = np.bincount(k, area / d, nodes.size)
+    g = np.bincount(k, area / length, nodes.size)
     depth = np.bincount(k, area * d, nodes.size) / A
-    return SurfaceContact(name, nodes, A, g, depth, area, d, k)
+    return SurfaceContact(name, nodes, A, g, depth, area, length, k)
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,7 +182,7 @@ class SurfaceMembership:
                 raise BoundaryConditionError(f"{self.what} {self.name!r} is a surface: it needs the solid's container "
                                              "(container=<the Shape>)")
             cells, pos = boundary.cells(graph)
-            c = surface_contact(cells, pos, self.surface, self.name, self.what)
+            c = surface_contact(cells, pos, self.surface, self.name, self.what, container=boundary.container)
             self._ids, self._contact = graph.ids[c.nodes].copy(), c
             return c
         present = np.isin(self._ids, graph.ids)

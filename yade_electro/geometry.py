@@ -103,6 +103,30 @@ class Shape:
         x = _pts(x)
         return [(self.sdf(x), lambda idx: self.gradient(x[idx]))]
 
+    def wall_curvature(self, x, h=None) -> np.ndarray:
+        """Sum of the principal curvatures k1 + k2 [1/m] of the wall at points ``x`` (n, 3)
+        on or near it: > 0 where the wall is convex seen from the solid (a rod's side,
+        1/R), < 0 where it is concave (a hole, -1/R), 0 on planes.
+
+        The Laplacian of the signed distance of the smooth piece of the wall nearest to each
+        point (:meth:`wall_terms`), by central differences of step ``h`` (default 1e-4 of
+        the bounding box): the pieces are smooth, so the creases of the whole shape's signed
+        distance (edges, corners) do not enter."""
+        x = _pts(x)
+        if h is None:
+            lo, hi = self.bounds()
+            h = 1e-4 * float(np.max(hi - lo))
+        g0 = np.stack([g for g, _ in self.wall_terms(x)], axis=1)
+        lap = -6.0 * g0
+        for k in range(3):
+            for s in (1.0, -1.0):
+                e = np.zeros(3)
+                e[k] = s * h
+                lap += np.stack([g for g, _ in self.wall_terms(x + e)], axis=1)
+        lap /= h * h
+        nearest = np.argmin(np.abs(g0), axis=1)
+        return lap[np.arange(x.shape[0]), nearest]
+
     def parts(self) -> tuple:
         """The shapes this one is combined from (empty for a primitive)."""
         return ()
@@ -418,6 +442,12 @@ class GridShape(Shape):
 
     def bounds(self):
         return self.lo + 2 * self.voxel, self.hi - 2 * self.voxel
+
+    def wall_curvature(self, x, h=None):
+        """Zero [1/m]: a field interpolated trilinearly from voxels has no usable second
+        derivative, so the walls of a sampled shape are taken as flat (surface conditions on
+        them get no curvature correction; see :mod:`yade_electro.boundary`)."""
+        return np.zeros(_pts(x).shape[0])
 
     def key(self):
         return self._key
