@@ -161,3 +161,29 @@ def test_crack_facets_stop_the_leak_through_a_half_section_crack():
     assert leak["paths"] > 2 * leak["facets"]   # 0.155
     with pytest.raises(ValueError, match="crack must be"):
         make_law("voronoi", container=box, crack="none")
+
+
+@pytest.mark.parametrize("hops", [1, 2, 3, 4])
+def test_compiled_hop_test_agrees_with_the_sparse_matrix_powers(hops):
+    """VoronoiFaces.linked by the compiled breadth-first helper against its fallback (powers of
+    the adjacency matrix), on random graphs with isolated nodes and long chains."""
+    from yade_electro import native
+    from yade_electro.voronoi import VoronoiFaces
+    rng = np.random.default_rng(hops)
+    n = 3000
+    b = np.sort(rng.integers(0, n, (4000, 2)), axis=1)
+    b = np.unique(b[b[:, 0] != b[:, 1]], axis=0)
+    pairs = np.sort(rng.integers(0, n, (20000, 2)), axis=1)
+    pairs = np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0)
+    pairs = np.concatenate([pairs, b])            # bonded pairs too: linked at every hops >= 1
+    faces = VoronoiFaces(pairs, np.ones(len(pairs)), n)
+    fast = faces.linked(b, hops)
+    saved = dict(native._HOPS)
+    native._HOPS["lib"] = native.NativeError("switched off for the test")
+    try:
+        slow = faces.linked(b, hops)
+    finally:
+        native._HOPS.clear()
+        native._HOPS.update(saved)
+    assert 0 < slow.sum() < slow.size
+    np.testing.assert_array_equal(fast, slow)

@@ -28,7 +28,7 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "NativeError"]
+__all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "NativeError"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -43,20 +43,22 @@ def cache_dir() -> Path:
     return Path(base) / "yade-electro"
 
 
-def _build(src: Path, name: str, libs) -> Path:
+def _build(src: Path, name: str, libs, shared: bool = False) -> Path:
     cache = cache_dir()
     cache.mkdir(parents=True, exist_ok=True)
     tag = hashlib.sha1(src.read_bytes()).hexdigest()[:12]        # the source's content, not its mtime
-    exe = cache / f"{name}_{tag}"
+    exe = cache / (f"lib{name}_{tag}.so" if shared else f"{name}_{tag}")
     if exe.exists():
         return exe
     cxx = shutil.which("g++")
     if cxx is None:
         raise NativeError("g++ not found (apt-get install g++; `make install` does)")
-    print(f"[yade-electro] building {name} (once, about 15 s) into {cache}", file=sys.stderr, flush=True)
+    print(f"[yade-electro] building {name} (once, {'a few seconds' if shared else 'about 15 s'}) into {cache}",
+          file=sys.stderr, flush=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{name}_", dir=str(cache))
     os.close(fd)
-    cmd = [cxx, "-O2", "-std=c++17", "-DNDEBUG", "-o", tmp, str(src)] + list(libs)
+    cmd = [cxx, "-O2", "-std=c++17", "-DNDEBUG"] + (["-shared", "-fPIC"] if shared else []) + ["-o", tmp, str(src)] \
+        + list(libs)
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         os.unlink(tmp)
@@ -132,3 +134,45 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
     if around.size != ni or counts.sum() != ni:
         raise NativeError("delaunay_cgal: short output")
     return cells, cc, pairs, counts, around
+
+
+_HOPS = {}
+
+
+def _hops_library():
+    """The built ``graph_hops`` library, loaded (raises :class:`NativeError` when it cannot be
+    built)."""
+    if "lib" not in _HOPS:
+        try:
+            import ctypes
+            lib = ctypes.CDLL(str(_build(HERE / "graph_hops.cpp", "graph_hops", [], shared=True)))
+            f = lib.graph_hops_linked
+            i64, ptr = ctypes.c_int64, ctypes.c_void_p
+            f.argtypes = [i64, ptr, ptr, i64, ptr, ptr, i64, ptr]
+            f.restype = ctypes.c_int
+            _HOPS["lib"] = f
+        except (NativeError, OSError) as exc:
+            _HOPS["lib"] = NativeError(f"graph_hops: {exc}")
+    if isinstance(_HOPS["lib"], Exception):
+        raise _HOPS["lib"]
+    return _HOPS["lib"]
+
+
+def hops_linked(indptr, indices, pairs, hops: int) -> np.ndarray:
+    """For each node pair (row of ``pairs``), is it linked by a path of at most ``hops`` edges of
+    the symmetric CSR adjacency ``indptr``, ``indices``? (bool array). The compiled
+    ``graph_hops`` helper: breadth-first balls of radius ceil(hops/2) around the first nodes
+    and hops - that around the second; pairs sorted by their first node share the first
+    ball. Raises :class:`NativeError` when it cannot be built (see
+    :meth:`yade_electro.voronoi.VoronoiFaces.linked` for the sparse-matrix fallback)."""
+    f = _hops_library()
+    ip = np.ascontiguousarray(indptr, dtype=np.int64)
+    ix = np.ascontiguousarray(indices, dtype=np.int64)
+    pr = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    pi, pj = np.ascontiguousarray(pr[:, 0]), np.ascontiguousarray(pr[:, 1])
+    n = ip.size - 1
+    out = np.zeros(pr.shape[0], dtype=np.uint8)
+    rc = f(n, ip.ctypes.data, ix.ctypes.data, pr.shape[0], pi.ctypes.data, pj.ctypes.data, int(hops), out.ctypes.data)
+    if rc != 0:
+        raise NativeError(f"graph_hops failed (code {rc}: {'a node index out of range' if rc == 2 else 'bad sizes'})")
+    return out.astype(bool)
