@@ -526,3 +526,32 @@ def test_deflation_caps_its_clusters():
     np.testing.assert_allclose(out[50][0], out[None][0], rtol=1e-7)
     with pytest.raises(ValueError, match="max_clusters must be >= 1"):
         DeflatedCGSolver(max_clusters=0)
+
+
+@pytest.mark.parametrize("repeats", [False, True])
+@pytest.mark.parametrize("with_groups", [False, True])
+def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
+    """ReducedSystem's K_uu and K_ud against a dense Laplacian, for distinct and repeated
+    edges (the scatter and the bincount paths), assembled twice in place."""
+    from yade_electro.condensation import ReducedSystem
+    rng = np.random.default_rng(7 + 2 * repeats + with_groups)
+    n = 80
+    e = np.sort(rng.integers(0, n, (300, 2)), axis=1)
+    e = np.unique(e[e[:, 0] != e[:, 1]], axis=0)
+    if repeats:
+        e = np.concatenate([e, e[::7]])
+    groups = [np.arange(0, 5), np.arange(10, 13)] if with_groups else []
+    rs = ReducedSystem(n, e, groups)
+    u = rs.unknown_nodes
+    for _ in range(2):
+        c = rng.random(len(e))
+        L = np.zeros((n, n))
+        np.add.at(L, (e[:, 0], e[:, 0]), c)
+        np.add.at(L, (e[:, 1], e[:, 1]), c)
+        np.add.at(L, (e[:, 0], e[:, 1]), -c)
+        np.add.at(L, (e[:, 1], e[:, 0]), -c)
+        Kuu, Kud = rs.assemble(c)
+        np.testing.assert_allclose(Kuu.toarray(), L[np.ix_(u, u)], rtol=1e-13, atol=1e-13)
+        if groups:
+            np.testing.assert_allclose(Kud.toarray(), np.column_stack([L[np.ix_(u, g)].sum(axis=1) for g in groups]),
+                                       rtol=1e-13, atol=1e-13)
