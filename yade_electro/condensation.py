@@ -129,9 +129,11 @@ class ReducedSystem:
         self._e_uu = None if nuu == m else _small_index(eid[uu], m)        # None: every edge
         self._off = (_small_index(slot[:nuu], nnz), _small_index(slot[nuu:2 * nuu], nnz))
         del slot
-        self._diag_uu = (_small_index(ui[uu], nu), _small_index(uj[uu], nu))
-        self._diag_ud = (_small_index(eid[ud_i], m), _small_index(ui[ud_i], nu),
-                         _small_index(eid[ud_j], m), _small_index(uj[ud_j], nu))
+        # the diagonal: the unknowns' incidence matrix (nu x m, ones), a CSR mat-vec
+        inc_rows = np.concatenate([ui[uu], uj[uu], ui[ud_i], uj[ud_j]])
+        self._incidence = sp.csr_matrix((np.ones(inc_rows.size), (inc_rows, np.concatenate(
+            [eid[uu], eid[uu], eid[ud_i], eid[ud_j]]))), shape=(nu, m))
+        del inc_rows
 
         # K_ud: -c between an unknown and a group
         rows = np.concatenate([ui[ud_i], uj[ud_j]])
@@ -172,10 +174,7 @@ class ReducedSystem:
             data[self.diagonal_slots] = 0.0
         else:                                 # repeated edges add up
             data[:] = -(np.bincount(o1, cu, data.size) + np.bincount(o2, cu, data.size))
-        d1, d2 = self._diag_uu
-        e_i, u_i, e_j, u_j = self._diag_ud
-        data[self.diagonal_slots] += (np.bincount(d1, cu, nu) + np.bincount(d2, cu, nu)
-                                      + np.bincount(u_i, c[e_i], nu) + np.bincount(u_j, c[e_j], nu))
+        data[self.diagonal_slots] += self._incidence @ c
         if diagonal is not None:
             self.Kuu.data[self.diagonal_slots] += diagonal
         self.Kud.data[:] = self._ud_map @ c
