@@ -30,8 +30,8 @@ import numpy as np
 from .errors import BoundaryConditionError
 from .geometry import as_surface
 
-__all__ = ["SurfaceContact", "surface_contact", "half_cell_length", "SavedSurface", "SurfaceMembership", "check_surface", "boundary_areas",
-           "BoundaryOfGraph"]
+__all__ = ["SurfaceContact", "surface_contact", "half_cell_length", "SavedSurface", "SurfaceMembership",
+           "check_surface", "boundary_areas", "BoundaryOfGraph"]
 
 
 @dataclass(frozen=True, eq=False)

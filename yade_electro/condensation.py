@@ -33,8 +33,8 @@ def _pattern(rows, cols, shape):
     Distinct pairs (the usual case: an edge list without repeats) go through scipy's COO to
     CSR conversion, a counting sort by row and a sort within each row, both in C, carrying
     each pair's position in ``data``; repeated pairs through a sort of one int64 key per
-    pair (np.unique). At 1M elements (16.7M pairs) the first takes about a third of the
-    time and memory of the second."""
+    pair (np.unique). With the first, the whole structure of the 1M-element ``voronoi``
+    system (16.7M pairs) took about 3 s instead of 7.8 s (``bench/bench_scale.py``)."""
     nr, nc = shape
     rows = np.asarray(rows)
     N = rows.size
@@ -117,8 +117,8 @@ class ReducedSystem:
         self.dropped = ~(uu | ud_i | ud_j | dd)   # same group, or touching an excluded node
 
         # K_uu: off-diagonals of unknown-unknown edges, the diagonal of every unknown. Kept as
-        # index arrays (int32 where they fit): each uu edge's two off-diagonal slots and the
-        # unknowns whose diagonals an edge adds to, filled by a scatter and bincounts
+        # index arrays (int32 where they fit): each uu edge's two off-diagonal slots, filled by
+        # a scatter, and the unknowns' incidence matrix for the diagonal
         rows = np.concatenate([ui[uu], uj[uu], np.arange(nu)])
         cols = np.concatenate([uj[uu], ui[uu], np.arange(nu)])
         self.Kuu, slot, self._uu_distinct = _pattern(rows, cols, (nu, nu))
@@ -165,7 +165,7 @@ class ReducedSystem:
         ``(Kuu, Kud)``."""
         c = np.asarray(values, dtype=float)
         self._assembled = True
-        nu, data = self.n_unknowns, self.Kuu.data
+        data = self.Kuu.data
         cu = c if self._e_uu is None else c[self._e_uu]
         o1, o2 = self._off
         if self._uu_distinct:                 # one edge per off-diagonal slot: a scatter

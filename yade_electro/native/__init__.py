@@ -14,6 +14,11 @@ volumes from CGAL's triangulation are exact only to 3.4e-12, against 5e-15 from 
 (``cases/slab_transient.py``'s finite-volume check; the cause is not found yet). The build takes about 15 s once; parallel
 processes (yade-batch) build into temporary names and rename, so they never run a half
 written executable.
+
+``graph_hops``: hop distances on a bond graph for the crack rules of the ``voronoi`` law
+(:func:`hops_linked`), a shared library loaded with ctypes. At 1M elements it answers the
+3-hop test of every Voronoi face in 0.24 s, where the sparse-matrix powers (the fallback
+without g++) took about 10 s and 1 GB.
 """
 from __future__ import annotations
 
