@@ -344,13 +344,14 @@ class DeflatedCGSolver(CGSolver):
         self._lab, self._k = lab, k
         rows = np.repeat(np.arange(n), np.diff(A.indptr))
         cols = A.indices
-        # W^T A (k x n): each non-zero (i, j) of A adds to (lab_i, j)
-        key = lab[rows] * n + cols
-        ukey, slot = np.unique(key, return_inverse=True)
-        self._wta_slot = slot
-        # a CSR matrix whose data[t] is the entry of the sorted unique key ukey[t]
-        indptr = np.searchsorted(ukey // n, np.arange(k + 1))
-        self._WtA = sp.csr_matrix((np.zeros(ukey.size), (ukey % n).astype(np.int32), indptr), shape=(k, n))
+        # W^T A (k x n): its pattern by one sparse product with W^T (scipy's, in C; a sort of
+        # one key per non-zero here cost more than the iterations at 5,000 unknowns). Where
+        # each non-zero of A goes in it is found at the first value update, so that updates
+        # refill it in place by a bincount (cheaper than a new product)
+        Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
+        self._WtA = Wt @ A
+        self._WtA.sort_indices()
+        self._wta_slot = None
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
         if k * k <= 50_000_000:          # the keys fit a count: the same sorted keys, no sort of nnz
@@ -364,7 +365,8 @@ class DeflatedCGSolver(CGSolver):
 
     def _coarse_values(self):
         A, k = self._Acsr, self._k
-        self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
+        if self._wta_slot is not None:
+            self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
         ev = np.bincount(self._e_slot, A.data, self._e_key.size)
         if k <= self.DENSE_LIMIT:
             # small coarse space: a dense Cholesky factor (LAPACK, no checks in the way)
@@ -396,6 +398,13 @@ class DeflatedCGSolver(CGSolver):
 
     def _update(self, A):
         self._set_diagonal()
+        if self._wta_slot is None:
+            # the entry (lab_i, j) of W^T A that each non-zero (i, j) of A adds to: a binary
+            # search among the sorted keys of its pattern
+            W, n = self._WtA, A.shape[0]
+            pattern = np.repeat(np.arange(self._k, dtype=np.int64), np.diff(W.indptr)) * n + W.indices
+            rows = np.repeat(np.arange(n), np.diff(self._Acsr.indptr))
+            self._wta_slot = np.searchsorted(pattern, self._lab[rows] * n + self._Acsr.indices)
         self._coarse_values()
 
     def _deflation(self):
