@@ -555,3 +555,24 @@ def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
         if groups:
             np.testing.assert_allclose(Kud.toarray(), np.column_stack([L[np.ix_(u, g)].sum(axis=1) for g in groups]),
                                        rtol=1e-13, atol=1e-13)
+
+
+def test_deflated_cg_after_value_updates_on_a_lattice_whose_cluster_sums_cancel():
+    """Uniform conductances on a lattice make many entries of the deflation's W^T A exactly 0
+    (a cluster's column sum of the Laplacian); after value updates the solver must still
+    refill every entry: the re-solves match the direct solution and converge as fast as a
+    cold solve."""
+    from lattice import cubic_lattice
+    g = cubic_lattice((12, 12, 30), r=1e-4)
+    el = [Electrode("top", np.arange(g.n_nodes - 144, g.n_nodes), potential=1.0),
+          Electrode("bottom", np.arange(144), potential=0.0)]
+    p = ConductionProblem(g.n_nodes, g.edges, np.full(len(g.edges), 2.5), el, solver="cg-deflated", coords=g.pos)
+    cold = p.solve().info["iterations"]
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        c2 = rng.uniform(0.5, 2.0, len(g.edges))
+        assert p.update_conductance(c2) == "values"
+        sol = p.solve()
+        ref = ConductionProblem(g.n_nodes, g.edges, c2, el, solver="direct").solve()
+        np.testing.assert_allclose(sol.potential, ref.potential, rtol=0, atol=1e-8)
+        assert sol.info["iterations"] <= cold + 10

@@ -344,13 +344,13 @@ class DeflatedCGSolver(CGSolver):
         self._lab, self._k = lab, k
         rows = np.repeat(np.arange(n), np.diff(A.indptr))
         cols = A.indices
-        # W^T A (k x n): its pattern by one sparse product with W^T (scipy's, in C; a sort of
-        # one key per non-zero here cost more than the iterations at 5,000 unknowns). Where
-        # each non-zero of A goes in it is found at the first value update, so that updates
-        # refill it in place by a bincount (cheaper than a new product)
-        Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
-        self._WtA = Wt @ A
-        self._WtA.sort_indices()
+        # W^T A (k x n): one sparse product with W^T (scipy's, in C; a sort of one key per
+        # non-zero here cost more than the iterations at 5,000 unknowns). The product drops
+        # entries that cancel (a cluster's column sum can be exactly 0), so the first value
+        # update makes the structural pattern (the product with |A|'s pattern) and where each
+        # non-zero of A goes in it; updates then refill it in place by a bincount
+        self._Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
+        self._WtA = self._Wt @ A
         self._wta_slot = None
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
@@ -399,12 +399,17 @@ class DeflatedCGSolver(CGSolver):
     def _update(self, A):
         self._set_diagonal()
         if self._wta_slot is None:
-            # the entry (lab_i, j) of W^T A that each non-zero (i, j) of A adds to: a binary
-            # search among the sorted keys of its pattern
-            W, n = self._WtA, A.shape[0]
+            # the structural pattern of W^T A (no cancellation: a product of ones) and the
+            # entry (lab_i, j) each non-zero (i, j) of A adds to, by a binary search among its
+            # sorted keys
+            Acsr, n = self._Acsr, A.shape[0]
+            ones = sp.csr_matrix((np.ones(Acsr.nnz), Acsr.indices, Acsr.indptr), shape=Acsr.shape)
+            W = self._Wt @ ones
+            W.sort_indices()
             pattern = np.repeat(np.arange(self._k, dtype=np.int64), np.diff(W.indptr)) * n + W.indices
-            rows = np.repeat(np.arange(n), np.diff(self._Acsr.indptr))
-            self._wta_slot = np.searchsorted(pattern, self._lab[rows] * n + self._Acsr.indices)
+            rows = np.repeat(np.arange(n), np.diff(Acsr.indptr))
+            self._wta_slot = np.searchsorted(pattern, self._lab[rows] * n + Acsr.indices)
+            self._WtA = W
         self._coarse_values()
 
     def _deflation(self):
