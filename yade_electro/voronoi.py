@@ -650,7 +650,7 @@ class VoronoiFaces:
         """Per face: are its two elements linked by a path of at most ``hops`` of ``bonds``?
 
         By the compiled breadth-first helper (:func:`yade_electro.native.hops_linked`:
-        memory of a few arrays per node; at 1M elements about 1 s); without a compiler, by
+        memory of a few arrays per node; at 1M elements 0.24 s); without a compiler, by
         powers of the sparse adjacency matrix (a matrix of every node's ``hops`` ball:
         about 60 entries per node at 3 hops on a lattice)."""
         import scipy.sparse as sp
