@@ -207,8 +207,10 @@ YADE_SCRIPT = textwrap.dedent("""
     out["gap"] = -i0.geom.penetrationDepth
     out["tension"] = -i0.phys.normalForce.dot(i0.geom.normal)
     out["tension_expected"] = i0.phys.kn * (i0.phys.unp - i0.geom.penetrationDepth)
-    # JCFpm variant on a fresh scene
+    # JCFpm variant on a fresh scene, every progress line printed
     O.reset()
+    import yade_electro.progress
+    yade_electro.progress.PROGRESS_EVERY = 0.0
     ids = P.add_bonded_packing(pk, material=JCFpmMat(young=210e9, poisson=0.3, density=7900, cohesion=5e8, tensileStrength=5e8, frictionAngle=0.4), detection_factor=k)
     real = [i for i in O.interactions if i.isReal]
     out["jcfpm_bonds"] = len(real)
@@ -243,6 +245,12 @@ def test_add_bonded_packing_in_yade(tmp_path, rod, cache, yade_exe):
     assert out["tension"] == pytest.approx(out["tension_expected"], rel=1e-6)
     assert out["jcfpm_bonds"] == n_ref and out["jcfpm_cohesive"]
     assert out["jcfpm_bonds_after"] == n_ref
+    # the progress lines of the bonding (shown with PROGRESS_EVERY = 0 in the JCFpm run only)
+    progress = [l for l in proc.stderr.splitlines() if l.startswith("[bonding]")]
+    assert any(f"{N} of {N}" in l and "spheres added" in l for l in progress), proc.stderr[-2000:]
+    assert any("bonds set stress-free: done in" in l for l in progress), proc.stderr[-2000:]
+    assert any("YADE's bonding step on" in l for l in progress), proc.stderr[-2000:]
+    assert sum("spheres added to O.bodies: done" in l for l in progress) == 1   # silent while PROGRESS_EVERY = 10 s
 
 
 @pytest.mark.yade

@@ -9,14 +9,32 @@ Units: SI.
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 
 from ..packing.statistics import DEFAULT_DETECTION_FACTOR
+from ..progress import Progress
 
 __all__ = ["steel_304L", "add_bonded_packing"]
 
 log = logging.getLogger(__name__)
+
+#: spheres added to ``O.bodies`` per call (a progress line can come between two)
+APPEND_CHUNK = 20000
+
+
+def _step_showing_progress(O, progress: Progress, note: str) -> None:
+    """One ``O.step()``, run in YADE's background thread so that a long one (the collider's
+    first sort and the bonding of every pair) prints progress lines; its errors are raised
+    here, by ``O.wait()``."""
+    O.run(1, False)
+    pause = 0.005
+    while O.running:
+        time.sleep(pause)
+        pause = min(2 * pause, 0.5)
+        progress.waiting(note)
+    O.wait()
 
 
 def steel_304L(**overrides):
@@ -110,8 +128,15 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     else:
         raise ValueError(f"material must be a CohFrictMat or a JCFpmMat, got {kind}")
     kw = {} if color is None else {"color": tuple(color)}
-    ids = O.bodies.append([utils.sphere(tuple(c), float(r), material=mat_id, **kw)
-                           for c, r in zip(packing.centers.tolist(), packing.radii.tolist())])
+    n_spheres = int(packing.radii.shape[0])
+    progress = Progress("bonding", f"{n_spheres:,} spheres added to O.bodies", n_spheres)
+    ids = []
+    centers, radii = packing.centers.tolist(), packing.radii.tolist()
+    for lo in range(0, n_spheres, APPEND_CHUNK):
+        ids += O.bodies.append([utils.sphere(tuple(c), float(r), material=mat_id, **kw)
+                                for c, r in zip(centers[lo:lo + APPEND_CHUNK], radii[lo:lo + APPEND_CHUNK])])
+        progress.update(len(ids))
+    progress.done()
     bo1 = W.Bo1_Sphere_Aabb(aabbEnlargeFactor=k)
     collider = W.InsertionSortCollider([bo1])
     # The cohesive law itself runs during the bonding step (YADE's InteractionLoop keeps the law
@@ -130,7 +155,8 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     O.engines = [W.ForceResetter(), collider, loop, newton]
     O.dt = min(O.dt, utils.PWaveTimeStep()) if O.dt > 0 else utils.PWaveTimeStep()
     try:
-        O.step()
+        _step_showing_progress(O, Progress("bonding", f"YADE's bonding step on {n_spheres:,} spheres"),
+                               "collision detection and bonds (one step, share done unknown)")
     finally:
         if strengths is not None:
             mat.normalCohesion, mat.shearCohesion = strengths
@@ -141,19 +167,29 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
         ip2.setCohesionNow = False
     else:
         ip2.cohesiveTresholdIteration = O.iter  # no cohesion for later contacts
-    ours = set(ids)
+    ours = np.zeros(max(ids) + 1, dtype=bool)
+    ours[ids] = True
+    radius = np.zeros(ours.shape[0])
+    radius[ids] = packing.radii
+    radius, ours = radius.tolist(), ours.tolist()
+    n_ours = len(ours)
     n_bonds = 0
-    for i in O.interactions:
-        if i.id1 in ours and i.id2 in ours:
+    progress = Progress("bonding", "bonds set stress-free", len(O.interactions))
+    for k, i in enumerate(O.interactions):
+        a, b = i.id1, i.id2
+        if a < n_ours and b < n_ours and ours[a] and ours[b]:
             if kind == "CohFrictMat":
                 ph = i.phys
                 ph.unp = i.geom.penetrationDepth
                 ph.normalForce = (0, 0, 0)
                 ph.shearForce = (0, 0, 0)
-                r2 = min(O.bodies[i.id1].shape.radius, O.bodies[i.id2].shape.radius) ** 2
+                r2 = min(radius[a], radius[b]) ** 2
                 ph.normalAdhesion = strengths[0] * r2
                 ph.shearAdhesion = strengths[1] * r2
             n_bonds += 1
+        if k % 4096 == 0:
+            progress.update(k)
+    progress.done()
     if kind == "CohFrictMat":
         # the forces of the bonding step (unp still 0 then: every gap pulled) stay in YADE's force
         # container until an integrator has consumed them; consume them in one step with every
@@ -163,7 +199,7 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
             b.state.blockedDOFs = "xyzXYZ"
         newton.dead = False
         O.dt = min(saved_dt, utils.PWaveTimeStep()) if saved_dt > 0 else utils.PWaveTimeStep()
-        O.step()
+        _step_showing_progress(O, Progress("bonding", "the step that flushes the bonding forces"), "running")
         newton.dead = True
         O.dt = saved_dt
         for b, dofs in held:

@@ -1,0 +1,36 @@
+"""Progress lines of long work (yade_electro.progress): pure Python, no YADE."""
+import io
+
+from yade_electro import progress as P
+
+
+def test_nothing_printed_for_short_work():
+    out = io.StringIO()
+    p = P.Progress("x", "items", 10, every=60.0, stream=out)
+    for k in range(10):
+        p.update(k + 1)
+    p.waiting("busy")
+    p.done()
+    assert out.getvalue() == ""
+
+
+def test_lines_with_done_total_and_time_left():
+    out = io.StringIO()
+    p = P.Progress("bonding", "bonds set", 1000, every=0.0, stream=out)
+    p.update(0)
+    p.update(250)
+    p.waiting("one step")
+    p.done()
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("[bonding] bonds set: 0 of 1,000") and "time left unknown yet" in lines[0]
+    assert "250 of 1,000" in lines[1] and "s left" in lines[1]
+    assert "one step" in lines[2] and "so far" in lines[2]
+    assert lines[3].startswith("[bonding] bonds set: done in")
+
+
+def test_default_interval_read_when_the_report_starts(monkeypatch):
+    monkeypatch.setattr(P, "PROGRESS_EVERY", 0.0)
+    out = io.StringIO()
+    p = P.Progress("x", "items", 2, stream=out)
+    p.update(1)
+    assert "1 of 2" in out.getvalue()
