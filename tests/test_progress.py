@@ -34,3 +34,23 @@ def test_default_interval_read_when_the_report_starts(monkeypatch):
     p = P.Progress("x", "items", 2, stream=out)
     p.update(1)
     assert "1 of 2" in out.getvalue()
+
+
+def test_jamming_shows_progress_within_trials(monkeypatch, capsys):
+    """Every trial of the jamming (and the initial cloud's relaxation) reports while it runs;
+    the packing is the same as without the lines."""
+    import numpy as np
+    from yade_electro.geometry import Cylinder
+    from yade_electro.packing import dense_packing
+    from yade_electro.packing import jamming
+    rod = Cylinder((0, 0, 0), (0, 0, 5e-3), 1e-3)
+    quiet = dense_packing(rod, n=150, seed=3, cache_dir=False)
+    capsys.readouterr()
+    monkeypatch.setattr(jamming, "PROGRESS_EVERY", 0.0)
+    loud = dense_packing(rod, n=150, seed=3, cache_dir=False)
+    err = capsys.readouterr().err.splitlines()
+    assert any("relaxing the initial random cloud: FIRE step" in l for l in err) or \
+        any("relaxing trial 1 " in l for l in err), err[:5]
+    assert any("relaxing trial" in l and "of at most 3000" in l for l in err), err[:5]
+    assert any("more trials of about" in l for l in err)
+    assert np.array_equal(quiet.centers, loud.centers) and np.array_equal(quiet.radii, loud.radii)

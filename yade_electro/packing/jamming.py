@@ -83,11 +83,12 @@ class Relaxer:
         self.energy = energy
         return F, maxov
 
-    def minimise(self, x, s, tol, max_steps, dt0=0.1, dt_max=0.5, window=200, stall=0.7):
+    def minimise(self, x, s, tol, max_steps, dt0=0.1, dt_max=0.5, window=200, stall=0.7, progress=None):
         """FIRE from ``x`` at scale ``s``. Returns (x, max_overlap, status, steps) where
         status is "ok" (max overlap < tol), "jammed" (the energy fell by less than a factor
         ``stall`` over the last ``window`` steps, or the forces balance with overlaps left)
-        or "budget" (max_steps reached)."""
+        or "budget" (max_steps reached). ``progress(step, max_steps, max_overlap)``, if
+        given, is called every 50 steps (it prints, or not, as it likes)."""
         x = x.copy()
         v = np.zeros_like(x)
         dt, alpha, n_pos = dt0, 0.1, 0
@@ -119,6 +120,8 @@ class Relaxer:
             v += F * dt
             x += v * dt
             F, maxov = self.forces(x, s)
+            if progress is not None and step % 50 == 0:
+                progress(step, max_steps, maxov)
         return x, maxov, ("ok" if maxov < tol else "budget"), max_steps
 
 
@@ -155,24 +158,36 @@ def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, s
     s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
     rel = Relaxer(shape, rho, r0, skin=skin)
     x = random_inside(shape, s * rho, r0, rng)
-    x, ov, status, steps = rel.minimise(x, s, tol, 20 * max_steps)
+    t0 = time.perf_counter()
+    clock = {"last": t0, "what": "the initial random cloud"}
+
+    def within_trial(step, budget, overlap):       # a trial longer than PROGRESS_EVERY shows progress too
+        now = time.perf_counter()
+        if now - clock["last"] >= PROGRESS_EVERY:
+            clock["last"] = now
+            print(f"[packing] {x.shape[0]} spheres: relaxing {clock['what']}: FIRE step {step} of at most "
+                  f"{budget}, largest overlap {overlap:.2g} r_mean (tolerance {tol:g}), {now - t0:.0f} s so far",
+                  file=sys.stderr, flush=True)
+
+    x, ov, status, steps = rel.minimise(x, s, tol, 20 * max_steps, progress=within_trial)
     total = steps
     if status != "ok":
         raise RuntimeError(f"could not remove the overlaps of the initial random cloud "
                            f"(fraction {phi_start}); max overlap {ov:.3g} r_mean")
     x_ok, s_ok, ds = x, s, ds0
     trials = 0
-    t0 = last = time.perf_counter()
+    t_trials = time.perf_counter()
     while ds >= ds_min and s_ok < s_max:
         now = time.perf_counter()
-        if now - last >= PROGRESS_EVERY:     # long work shows progress (stderr)
-            last = now
+        if now - clock["last"] >= PROGRESS_EVERY:     # long work shows progress (stderr)
+            clock["last"] = now
             left = max(0.0, math.log2(ds / ds_min)) + 1.0
             print(f"[packing] {x.shape[0]} spheres: volume fraction {phi_nom * s_ok ** 3:.4f}, growth step {ds:.2g} "
-                  f"(stops below {ds_min:g}: at least {left:.0f} more trials of about {(now - t0) / max(trials, 1):.0f} s, "
-                  f"{trials} done in {now - t0:.0f} s)", file=sys.stderr, flush=True)
+                  f"(stops below {ds_min:g}: at least {left:.0f} more trials of about {(now - t_trials) / max(trials, 1):.0f} s, "
+                  f"{trials} done in {now - t_trials:.0f} s)", file=sys.stderr, flush=True)
         s_try = min(s_max, s_ok * (1 + ds))
-        x_try, ov, status, steps = rel.minimise(x_ok, s_try, tol, max_steps)
+        clock["what"] = f"trial {trials + 1} (volume fraction {phi_nom * s_try ** 3:.4f})"
+        x_try, ov, status, steps = rel.minimise(x_ok, s_try, tol, max_steps, progress=within_trial)
         total += steps
         trials += 1
         log.debug("jam: s=%.5f fraction=%.4f %s in %d steps (ds=%.2g)", s_try,
