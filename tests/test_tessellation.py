@@ -109,11 +109,16 @@ def test_thread_setting(monkeypatch):
         tessellation_threads()
 
 
-def test_cgal_and_qhull_give_the_same_faces():
+def test_cgal_and_qhull_give_the_same_faces(monkeypatch, capsys):
+    from yade_electro import progress
     from yade_electro.native import cgal_executable
     cgal_executable()                                # built here (make install brings g++ and CGAL)
     pts, n = _cloud(5000, 3)
+    capsys.readouterr()
+    monkeypatch.setattr(progress, "PROGRESS_EVERY", 0.0)        # the helper's wait shows progress
     a = tessellate(pts, n, backend="cgal")
+    assert "points triangulated by CGAL: done in" in capsys.readouterr().err
+    monkeypatch.setattr(progress, "PROGRESS_EVERY", 10.0)
     b = tessellate(pts, n, backend="qhull")
     aa, ca, _ = a.face_geometry()
     ab, cb, _ = b.face_geometry()

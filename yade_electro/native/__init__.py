@@ -124,11 +124,22 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
         with open(fin, "wb") as fh:
             np.array([P.shape[0]], np.int64).tofile(fh)
             P.tofile(fh)
-        r = subprocess.run([str(exe), fin, fout, str(int(n_real))], capture_output=True, text=True)
-        if r.returncode == 3:
+        from ..progress import Progress
+        progress = Progress("voronoi", f"{P.shape[0]:,} points triangulated by CGAL")
+        proc = subprocess.Popen([str(exe), fin, fout, str(int(n_real))], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        while True:                      # a long triangulation (about 20 s at 1M) shows progress
+            progress.waiting("the helper process runs")
+            try:
+                _, err = proc.communicate(timeout=0.5)
+                break
+            except subprocess.TimeoutExpired:
+                pass
+        progress.done()
+        if proc.returncode == 3:
             raise NativeError("delaunay_cgal: some points coincide (CGAL keeps one of each)")
-        if r.returncode != 0:
-            raise NativeError(f"delaunay_cgal failed (exit {r.returncode}): {r.stderr.strip()[-500:]}")
+        if proc.returncode != 0:
+            raise NativeError(f"delaunay_cgal failed (exit {proc.returncode}): {err.strip()[-500:]}")
         with open(fout, "rb") as fh:
             nv, nc, ne, ni = (int(v) for v in np.fromfile(fh, np.int64, 4))
             cells = np.fromfile(fh, np.int64, 4 * nc).reshape(nc, 4)
