@@ -54,20 +54,24 @@ def public(row):
 
 def sweep_runs(run_one, sizes, laws, out_dir, csv_name, fields, summary_line):
     """``run_one(n, law)`` for every size x law; each row is appended to ``csv_name`` in
-    ``out_dir`` as it comes (so a crash keeps the rows done) and its summary line printed.
+    ``out_dir`` as it comes (so a crash keeps the rows done) and its summary line printed, then a
+    progress line on stderr (runs done, time spent, an estimate of the time left).
     Returns the rows."""
+    from yade_electro.progress import Progress
     os.makedirs(out_dir, exist_ok=True)
     rows = []
+    runs = [(n, law) for n in sizes for law in laws]
+    progress = Progress("sweep", "runs", len(runs), every=0.0)     # a line after every run, with the time left
     with open(os.path.join(out_dir, csv_name), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
-        for n in sizes:
-            for law in laws:
-                row = run_one(n, law)
-                rows.append(row)
-                w.writerow(public(row))
-                fh.flush()
-                print(summary_line(row), flush=True)
+        for n, law in runs:
+            row = run_one(n, law)
+            rows.append(row)
+            w.writerow(public(row))
+            fh.flush()
+            print(summary_line(row), flush=True)
+            progress.update(len(rows))
     return rows
 
 

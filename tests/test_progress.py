@@ -54,3 +54,16 @@ def test_jamming_shows_progress_within_trials(monkeypatch, capsys):
     assert any("relaxing trial" in l and "of at most 3000" in l for l in err), err[:5]
     assert any("more trials of about" in l for l in err)
     assert np.array_equal(quiet.centers, loud.centers) and np.array_equal(quiet.radii, loud.radii)
+
+
+def test_sweeps_print_runs_done_and_time_left(tmp_path, capsys):
+    import os
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "cases"))
+    import caselib
+    rows = caselib.sweep_runs(lambda n, law: {"n": n, "law": law}, [10, 20], ["a"], str(tmp_path), "s.csv",
+                              ["n", "law"], lambda row: f"n={row['n']}")
+    err = capsys.readouterr().err
+    assert len(rows) == 2
+    assert "[sweep] runs: 1 of 2 in 0 s, about 0 s left" in err and "[sweep] runs: 2 of 2" in err
+    assert (tmp_path / "s.csv").read_text().splitlines() == ["n,law", "10,a", "20,a"]
