@@ -98,6 +98,31 @@ def test_dense_packing_is_cached_and_reproducible(rod, cache):
     assert not other.from_cache and not np.array_equal(other.centers, rod.centers)
 
 
+def test_compiled_pair_forces_are_the_numpy_ones_to_the_last_bit(monkeypatch):
+    """The jamming's compiled sphere-sphere forces (native/soft_spheres.cpp) give the same bits
+    as the numpy form, so the packings (and every figure made from them) do not change."""
+    from scipy.spatial import cKDTree
+    import yade_electro.native as native
+    from yade_electro.packing import jamming
+    rng = np.random.default_rng(0)
+    x = rng.random((2000, 3)) * 9.0
+    rho = 0.9 + 0.2 * rng.random(2000)
+    pairs = cKDTree(x).query_pairs(2.6, output_type="ndarray")
+    for s in (0.7, 1.0, 1.1):
+        a = jamming.pair_forces_numpy(x, rho, s, pairs)
+        b = native.soft_sphere_forces(x, rho, s, pairs)
+        assert a[1].size > 0
+        assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and a[2] == b[2]
+    assert native.soft_sphere_forces(x, rho, 0.01, pairs)[1].size == 0         # no overlap at all
+    fast = P.dense_packing(ROD, n=400, seed=5, cache_dir=False)
+
+    def unavailable(*args, **kw):
+        raise native.NativeError("not built")
+    monkeypatch.setattr(native, "soft_sphere_forces", unavailable)             # the numpy fallback
+    slow = P.dense_packing(ROD, n=400, seed=5, cache_dir=False)
+    assert np.array_equal(fast.centers, slow.centers) and np.array_equal(fast.radii, slow.radii)
+
+
 def test_r_mean_mode_and_errors(cache):
     box = P.Box((0, 0, 0), (1e-3, 1e-3, 1e-3))
     r = 0.1e-3

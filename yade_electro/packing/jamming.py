@@ -14,12 +14,35 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..native import NativeError
+
 __all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps"]
 
 log = logging.getLogger(__name__)
 
 #: seconds between two progress lines of a long jamming run
 PROGRESS_EVERY = 10.0
+
+
+def pair_forces_numpy(x, rho, s, p):
+    """The numpy form of the sphere-sphere forces (see :meth:`Relaxer.forces`): forces
+    (n, 3), the overlaps of the overlapping pairs in pair order, the largest overlap."""
+    n = x.shape[0]
+    i, j = p[:, 0], p[:, 1]
+    d = x[j] - x[i]
+    d2 = np.einsum("ij,ij->i", d, d)
+    rs = s * (rho[i] + rho[j])
+    m = d2 < rs * rs
+    F = np.zeros((n, 3))
+    if not np.any(m):
+        return F, np.zeros(0), 0.0
+    i, j, d, rs = i[m], j[m], d[m], rs[m]
+    dist = np.sqrt(d2[m])
+    ov = rs - dist
+    f = d * (ov / np.maximum(dist, 1e-12))[:, None]
+    for k in range(3):
+        F[:, k] += np.bincount(j, f[:, k], n) - np.bincount(i, f[:, k], n)
+    return F, ov, float(ov.max())
 
 
 class Relaxer:
@@ -30,8 +53,9 @@ class Relaxer:
     minimised with FIRE (Bitzek et al. 2006) using a Verlet pair list (cKDTree).
     """
 
-    def __init__(self, shape, rho, r0, skin=0.4):
+    def __init__(self, shape, rho, r0, skin=0.4, native=True):
         self.shape, self.rho, self.r0, self.skin = shape, rho, r0, skin
+        self.native = bool(native)
         self.rho_max = float(rho.max())
         self.pairs = None
         self.x_ref = None
@@ -50,28 +74,25 @@ class Relaxer:
         self.n_rebuild += 1
         return self.pairs
 
+    def _pair_forces(self, x, s, p):
+        """Sphere-sphere forces, overlaps (in pair order) and the largest: compiled
+        (:func:`yade_electro.native.soft_sphere_forces`, the same bits) unless ``native`` is
+        False or the helper cannot be built."""
+        if self.native:
+            try:
+                from ..native import soft_sphere_forces
+                return soft_sphere_forces(x, self.rho, s, p)
+            except NativeError as exc:
+                log.info("jamming: the compiled pair forces are not available (%s); numpy instead", exc)
+                self.native = False
+        return pair_forces_numpy(x, self.rho, s, p)
+
     def forces(self, x, s):
         """Forces (n, 3) and the largest overlap (sphere-sphere or wall penetration)."""
         self.n_force += 1
-        n = x.shape[0]
         p = self._pairs(x, s)
-        i, j = p[:, 0], p[:, 1]
-        d = x[j] - x[i]
-        d2 = np.einsum("ij,ij->i", d, d)
-        rs = s * (self.rho[i] + self.rho[j])
-        m = d2 < rs * rs
-        F = np.zeros((n, 3))
-        maxov = 0.0
-        energy = 0.0
-        if np.any(m):
-            i, j, d, rs = i[m], j[m], d[m], rs[m]
-            dist = np.sqrt(d2[m])
-            ov = rs - dist
-            maxov = float(ov.max())
-            energy = 0.5 * float(ov @ ov)
-            f = d * (ov / np.maximum(dist, 1e-12))[:, None]
-            for k in range(3):
-                F[:, k] += np.bincount(j, f[:, k], n) - np.bincount(i, f[:, k], n)
+        F, ov, maxov = self._pair_forces(x, s, p)
+        energy = 0.5 * float(ov @ ov) if ov.size else 0.0
         rad = s * self.rho
         for g, normal in self.shape.wall_terms(x * self.r0):
             phi = g / self.r0 + rad
