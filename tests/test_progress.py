@@ -67,3 +67,14 @@ def test_sweeps_print_runs_done_and_time_left(tmp_path, capsys):
     assert len(rows) == 2
     assert "[sweep] runs: 1 of 2 in 0 s, about 0 s left" in err and "[sweep] runs: 2 of 2" in err
     assert (tmp_path / "s.csv").read_text().splitlines() == ["n,law", "10,a", "20,a"]
+
+
+def test_tessellation_slabs_report_through_the_same_reporter(monkeypatch, capsys):
+    from yade_electro import voronoi
+    monkeypatch.setattr(P, "PROGRESS_EVERY", 0.0)
+    report = voronoi._progress_lines(1234)
+    report(1, 4, 0.1)
+    report(4, 4, 0.2)
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("[voronoi] 1,234 points, slabs tessellated: 1 of 4 in")
+    assert err[-1].startswith("[voronoi] 1,234 points, slabs tessellated: done in")

@@ -40,7 +40,6 @@ Units: metres, m^2.
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -202,21 +201,17 @@ def _tessellate(pos, radius, ghosts):
     return pts, tessellate(pts, pos.shape[0], n_far=far.shape[0], progress=_progress_lines(pts.shape[0]))
 
 
-#: seconds between progress lines of a long tessellation
-PROGRESS_EVERY = 10.0
-
-
 def _progress_lines(n_points):
-    """A progress callback printing a line to stderr at most every PROGRESS_EVERY s, with
-    the slabs done and an estimate of the time left."""
-    last = [0.0]
+    """A progress callback for the qhull slabs (:class:`yade_electro.progress.Progress`: a
+    line on stderr at most every PROGRESS_EVERY s, with the slabs done and the time left)."""
+    from .progress import Progress
+    report = Progress("voronoi", f"{n_points:,} points, slabs tessellated")     # the clock starts here
 
     def progress(done, total, elapsed):
-        if elapsed - last[0] >= PROGRESS_EVERY or (done == total and elapsed >= PROGRESS_EVERY):
-            last[0] = elapsed
-            left = elapsed / done * (total - done)
-            print(f"[voronoi] {n_points} points: {done} of {total} slabs tessellated in {elapsed:.0f} s, "
-                  f"about {left:.0f} s left", file=sys.stderr, flush=True)
+        report.total = int(total)
+        report.update(done)
+        if done == total:
+            report.done()
     return progress
 
 
