@@ -164,7 +164,7 @@ def test_crack_facets_stop_the_leak_through_a_half_section_crack():
 
 
 @pytest.mark.parametrize("hops", [1, 2, 3, 4])
-def test_compiled_hop_test_agrees_with_the_sparse_matrix_powers(hops):
+def test_compiled_hop_test_agrees_with_the_sparse_matrix_powers(hops, monkeypatch):
     """VoronoiFaces.linked by the compiled breadth-first helper against its fallback (powers of
     the adjacency matrix), on random graphs with isolated nodes and long chains."""
     from yade_electro import native
@@ -178,12 +178,10 @@ def test_compiled_hop_test_agrees_with_the_sparse_matrix_powers(hops):
     pairs = np.concatenate([pairs, b])            # bonded pairs too: linked at every hops >= 1
     faces = VoronoiFaces(pairs, np.ones(len(pairs)), n)
     fast = faces.linked(b, hops)
-    saved = dict(native._HOPS)
-    native._HOPS["lib"] = native.NativeError("switched off for the test")
-    try:
-        slow = faces.linked(b, hops)
-    finally:
-        native._HOPS.clear()
-        native._HOPS.update(saved)
+
+    def unavailable(*args, **kw):
+        raise native.NativeError("switched off for the test")
+    monkeypatch.setattr(native, "hops_linked", unavailable)
+    slow = faces.linked(b, hops)
     assert 0 < slow.sum() < slow.size
     np.testing.assert_array_equal(fast, slow)

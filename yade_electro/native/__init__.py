@@ -158,26 +158,32 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
     return cells, cc, pairs, counts, around
 
 
-_HOPS = {}
+_LIBRARIES = {}
+
+
+def _shared_function(name: str, symbol: str, argtypes, restype, flags=()):
+    """The function ``symbol`` of the shared library built from ``<name>.cpp``, loaded once
+    with ctypes (raises :class:`NativeError`, kept for later calls, when it cannot be built)."""
+    if name not in _LIBRARIES:
+        try:
+            import ctypes
+            lib = ctypes.CDLL(str(_build(HERE / f"{name}.cpp", name, list(flags), shared=True)))
+            f = getattr(lib, symbol)
+            f.argtypes, f.restype = argtypes, restype
+            _LIBRARIES[name] = f
+        except (NativeError, OSError) as exc:
+            _LIBRARIES[name] = NativeError(f"{name}: {exc}")
+    if isinstance(_LIBRARIES[name], Exception):
+        raise _LIBRARIES[name]
+    return _LIBRARIES[name]
 
 
 def _hops_library():
-    """The built ``graph_hops`` library, loaded (raises :class:`NativeError` when it cannot be
+    """The built ``graph_hops`` library's search (raises :class:`NativeError` when it cannot be
     built)."""
-    if "lib" not in _HOPS:
-        try:
-            import ctypes
-            lib = ctypes.CDLL(str(_build(HERE / "graph_hops.cpp", "graph_hops", [], shared=True)))
-            f = lib.graph_hops_linked
-            i64, ptr = ctypes.c_int64, ctypes.c_void_p
-            f.argtypes = [i64, ptr, ptr, i64, ptr, ptr, i64, ptr]
-            f.restype = ctypes.c_int
-            _HOPS["lib"] = f
-        except (NativeError, OSError) as exc:
-            _HOPS["lib"] = NativeError(f"graph_hops: {exc}")
-    if isinstance(_HOPS["lib"], Exception):
-        raise _HOPS["lib"]
-    return _HOPS["lib"]
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    return _shared_function("graph_hops", "graph_hops_linked", [i64, ptr, ptr, i64, ptr, ptr, i64, ptr], ctypes.c_int)
 
 
 def hops_linked(indptr, indices, pairs, hops: int) -> np.ndarray:
@@ -200,27 +206,13 @@ def hops_linked(indptr, indices, pairs, hops: int) -> np.ndarray:
     return out.astype(bool)
 
 
-_SOFT = {}
-
-
 def _soft_library():
-    """The ``soft_sphere_forces`` function of the compiled ``soft_spheres`` helper (raises
-    :class:`NativeError` when it cannot be built)."""
-    if "lib" not in _SOFT:
-        try:
-            import ctypes
-            lib = ctypes.CDLL(str(_build(HERE / "soft_spheres.cpp", "soft_spheres", ["-ffp-contract=off"],
-                                         shared=True)))
-            f = lib.soft_sphere_forces
-            i64, ptr = ctypes.c_int64, ctypes.c_void_p
-            f.argtypes = [i64, ptr, ptr, ctypes.c_double, i64, ptr, ptr, ptr, ptr]
-            f.restype = i64
-            _SOFT["lib"] = f
-        except (NativeError, OSError) as exc:
-            _SOFT["lib"] = NativeError(f"soft_spheres: {exc}")
-    if isinstance(_SOFT["lib"], Exception):
-        raise _SOFT["lib"]
-    return _SOFT["lib"]
+    """The ``soft_sphere_forces`` function of the compiled ``soft_spheres`` helper, built
+    without floating-point contraction (raises :class:`NativeError` when it cannot be built)."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    return _shared_function("soft_spheres", "soft_sphere_forces", [i64, ptr, ptr, ctypes.c_double, i64, ptr, ptr, ptr, ptr],
+                            i64, flags=["-ffp-contract=off"])
 
 
 def soft_sphere_forces(x, rho, s: float, pairs):
