@@ -123,6 +123,44 @@ def test_compiled_pair_forces_are_the_numpy_ones_to_the_last_bit(monkeypatch):
     assert np.array_equal(fast.centers, slow.centers) and np.array_equal(fast.radii, slow.radii)
 
 
+def test_compiled_fire_steps_agree_with_numpy():
+    """The compiled FIRE steps of large packings (native/fire_steps.cpp) against the numpy
+    forms to rounding: the Verlet list (the same pairs as cKDTree, sorted by the first
+    sphere), the pair forces and energy on one and two threads, the power and the move."""
+    from scipy.spatial import cKDTree
+    import yade_electro.native as native
+    from yade_electro.packing import jamming
+    rng = np.random.default_rng(1)
+    n = 30000                                            # > 100,000 pairs: the two-thread path
+    x = np.ascontiguousarray(rng.random((n, 3)) * [20.0, 20.0, 60.0])
+    x = np.ascontiguousarray(x[jamming.morton_order(x)])
+    rho = 0.9 + 0.2 * rng.random(n)
+    fire = native.FireSteps(threads=1)
+    pairs = fire.pairs_within(x, 2.6)
+    ref = cKDTree(x).query_pairs(2.6, output_type="ndarray")
+    assert pairs.shape == ref.shape and pairs.shape[0] > 100000
+    assert np.array_equal(np.sort(pairs[:, 0] * n + pairs[:, 1]), np.sort(ref[:, 0] * n + ref[:, 1]))
+    assert np.all(np.diff(pairs[:, 0]) >= 0) and np.all(pairs[:, 0] < pairs[:, 1])
+    F_np, ov, mx = jamming.pair_forces_numpy(x, rho, 1.0, pairs)
+    for threads in (1, 2):
+        fire.threads = threads
+        F = np.empty_like(x)
+        energy, mx_c, m = fire.pair_forces(x, rho, 1.0, pairs, F)
+        assert m == ov.size > 1000 and mx_c == mx
+        assert np.allclose(F, F_np, rtol=0, atol=1e-12 * np.abs(F_np).max())
+        assert energy == pytest.approx(0.5 * float(ov @ ov), rel=1e-12)
+    v = rng.standard_normal((n, 3))
+    fmax, P, vn, fn = fire.power(F_np, v)
+    assert fmax == pytest.approx(np.sqrt(np.max(np.einsum("ij,ij->i", F_np, F_np))), rel=1e-14)
+    assert P == pytest.approx(np.einsum("ij,ij->", F_np, v), rel=1e-10)
+    assert (vn, fn) == pytest.approx((np.linalg.norm(v), np.linalg.norm(F_np)), rel=1e-12)
+    x2, v2 = x.copy(), v.copy()
+    fire.move(x2, v2, F_np, 0.9, 0.3, 0.1)
+    w = 0.9 * v + 0.3 * F_np + 0.1 * F_np
+    assert np.allclose(v2, w, rtol=1e-14, atol=0) and np.allclose(x2, x + 0.1 * w, rtol=1e-14, atol=0)
+    assert fire.max_move(x2, x) == pytest.approx(np.max(np.linalg.norm(x2 - x, axis=1)), rel=1e-14)
+
+
 def test_spatial_order_of_large_packings(monkeypatch):
     """From SPATIAL_ORDER_FROM spheres on, the jamming works in Morton order (sorted pairs,
     wall terms on the wall's candidates only) and returns the spheres in their own order: the

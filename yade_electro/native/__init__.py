@@ -39,7 +39,7 @@ from typing import Optional
 import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
-           "NativeError"]
+           "FireSteps", "NativeError"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -164,18 +164,19 @@ _LIBRARIES = {}
 def _shared_function(name: str, symbol: str, argtypes, restype, flags=()):
     """The function ``symbol`` of the shared library built from ``<name>.cpp``, loaded once
     with ctypes (raises :class:`NativeError`, kept for later calls, when it cannot be built)."""
-    if name not in _LIBRARIES:
+    key = (name, symbol)
+    if key not in _LIBRARIES:
         try:
             import ctypes
             lib = ctypes.CDLL(str(_build(HERE / f"{name}.cpp", name, list(flags), shared=True)))
             f = getattr(lib, symbol)
             f.argtypes, f.restype = argtypes, restype
-            _LIBRARIES[name] = f
-        except (NativeError, OSError) as exc:
-            _LIBRARIES[name] = NativeError(f"{name}: {exc}")
-    if isinstance(_LIBRARIES[name], Exception):
-        raise _LIBRARIES[name]
-    return _LIBRARIES[name]
+            _LIBRARIES[key] = f
+        except (NativeError, OSError, AttributeError) as exc:
+            _LIBRARIES[key] = NativeError(f"{name}: {exc}")
+    if isinstance(_LIBRARIES[key], Exception):
+        raise _LIBRARIES[key]
+    return _LIBRARIES[key]
 
 
 def _hops_library():
@@ -232,3 +233,78 @@ def soft_sphere_forces(x, rho, s: float, pairs):
     m = f(n, x.ctypes.data, rho.ctypes.data, float(s), pr.shape[0], pr.ctypes.data, F.ctypes.data, ov.ctypes.data,
           ctypes.byref(mx))
     return F, ov[:m], float(mx.value)
+
+
+class FireSteps:
+    """The compiled vector work of one FIRE step of the jamming (``fire_steps.cpp``), for large
+    packings in spatial order (:data:`yade_electro.packing.jamming.SPATIAL_ORDER_FROM`): one
+    pass over the arrays per operation instead of numpy's temporaries. Not the same bits as
+    the numpy form. Raises :class:`NativeError` when the helper cannot be built.
+
+    Arrays: ``x``, ``v``, ``F`` (n, 3) float64 C-contiguous (``F`` and ``v`` are written in
+    place), ``rho`` (n,), ``pairs`` (p, 2) int64. ``threads`` (1 or 2, default 2 where the
+    machine has two cores): the pair forces from 100,000 pairs on are split in two halves,
+    one per thread."""
+
+    def __init__(self, threads: Optional[int] = None):
+        import ctypes
+        i64, ptr, dbl = ctypes.c_int64, ctypes.c_void_p, ctypes.c_double
+
+        def load(symbol, argtypes, restype):
+            return _shared_function("fire_steps", symbol, argtypes, restype, flags=["-pthread"])
+        self._forces = load("fire_pair_forces", [i64, ptr, ptr, dbl, i64, ptr, ptr, ptr, i64], i64)
+        self._power = load("fire_power", [i64, ptr, ptr, ptr], None)
+        self._move = load("fire_move", [i64, ptr, ptr, ptr, dbl, dbl, dbl], None)
+        self._max_move2 = load("fire_max_move2", [i64, ptr, ptr], dbl)
+        self._pairs_within = load("fire_pairs_within", [i64, ptr, dbl, i64, ptr], i64)
+        # the pair forces on two threads (the pairs in two halves) where there are two cores
+        self.threads = min(2, os.cpu_count() or 1) if threads is None else max(1, min(2, int(threads)))
+        self._out = np.zeros(4)
+        self._room = 0
+
+    @staticmethod
+    def _check(*arrays):
+        for a in arrays:
+            if not (a.dtype == np.float64 and a.flags.c_contiguous):
+                raise ValueError("FireSteps needs C-contiguous float64 arrays")
+
+    def pair_forces(self, x, rho, s: float, pairs, F):
+        """Forces into ``F`` (n, 3); returns (energy, largest overlap, overlapping pairs)."""
+        self._check(x, rho, F)
+        pr = np.ascontiguousarray(pairs, dtype=np.int64)
+        m = self._forces(x.shape[0], x.ctypes.data, rho.ctypes.data, float(s), pr.shape[0], pr.ctypes.data,
+                         F.ctypes.data, self._out.ctypes.data, self.threads)
+        return float(self._out[0]), float(self._out[1]), int(m)
+
+    def power(self, F, v):
+        """(max_i |F_i|, F.v, |v|, |F|)."""
+        self._check(F, v)
+        self._power(F.shape[0], F.ctypes.data, v.ctypes.data, self._out.ctypes.data)
+        o = self._out
+        return float(np.sqrt(o[0])), float(o[1]), float(np.sqrt(o[2])), float(np.sqrt(o[3]))
+
+    def move(self, x, v, F, a: float, b: float, dt: float):
+        """v = a v + b F + dt F, then x += dt v (both in place)."""
+        self._check(x, v, F)
+        self._move(x.shape[0], x.ctypes.data, v.ctypes.data, F.ctypes.data, float(a), float(b), float(dt))
+
+    def max_move(self, x, ref) -> float:
+        """max_i |x_i - ref_i|."""
+        self._check(x, ref)
+        return float(np.sqrt(self._max_move2(x.shape[0], x.ctypes.data, ref.ctypes.data)))
+
+    def pairs_within(self, x, cut: float) -> np.ndarray:
+        """Every pair (i, j), i < j, closer than ``cut``, sorted by i (a grid of cells of side
+        >= cut): the Verlet list, as ``cKDTree.query_pairs`` gives it but in this order."""
+        self._check(x)
+        n = x.shape[0]
+        room = max(self._room, 8 * n, 16)
+        while True:
+            out = np.empty((room, 2), dtype=np.int64)
+            m = self._pairs_within(n, x.ctypes.data, float(cut), room, out.ctypes.data)
+            if m < 0:
+                raise NativeError("fire_pairs_within: the cell grid would be too large (cut too small for the box)")
+            if m <= room:
+                self._room = int(1.25 * m)
+                return out[:m]
+            room = int(1.25 * m)

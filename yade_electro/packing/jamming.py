@@ -88,6 +88,8 @@ class Relaxer:
         # list is sorted and the wall terms are evaluated on the wall's candidates only
         self.spatial = bool(spatial)
         self.wall_candidates = None
+        self._fire = None           # the compiled FIRE steps (spatial mode), once built
+        self._F = None
         self.rho_max = float(rho.max())
         self.pairs = None
         self.x_ref = None
@@ -95,19 +97,42 @@ class Relaxer:
         self.n_rebuild = 0
         self.n_force = 0
 
+    def fire_steps(self):
+        """The compiled FIRE steps (:class:`yade_electro.native.FireSteps`) in spatial mode,
+        None otherwise or when they cannot be built (numpy then)."""
+        if not self.spatial or not self.native:
+            return None
+        if self._fire is None:
+            try:
+                from ..native import FireSteps
+                self._fire = FireSteps()
+            except NativeError as exc:
+                log.info("jamming: the compiled FIRE steps are not available (%s); numpy instead", exc)
+                self._fire = False
+        return self._fire or None
+
     def _pairs(self, x, s):
         if self.pairs is not None:
-            d = x - self.x_ref
-            disp = np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))
+            fire = self.fire_steps()
+            if fire is not None:
+                disp = fire.max_move(x, self.x_ref)
+            else:
+                d = x - self.x_ref
+                disp = np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))
             if 2 * disp + 2 * (s - self.s_ref) * self.rho_max < self.skin:
                 return self.pairs
         cut = 2 * s * self.rho_max + self.skin
-        self.pairs = cKDTree(x).query_pairs(cut, output_type="ndarray")
+        fire = self.fire_steps()
+        if fire is not None:        # sorted by the first sphere: a cell grid, in C
+            self.pairs = fire.pairs_within(x, cut)
+        else:
+            self.pairs = cKDTree(x).query_pairs(cut, output_type="ndarray")
         if self.spatial:
-            # pairs in the spheres' (spatial) order: the scatter of the forces walks memory
-            # forwards instead of at random
-            key = self.pairs[:, 0].astype(np.int64) * x.shape[0] + self.pairs[:, 1]
-            self.pairs = self.pairs[np.argsort(key)]
+            if fire is None:
+                # pairs in the spheres' (spatial) order: the scatter of the forces walks
+                # memory forwards instead of at random
+                key = self.pairs[:, 0].astype(np.int64) * x.shape[0] + self.pairs[:, 1]
+                self.pairs = self.pairs[np.argsort(key)]
             # the spheres that can touch a wall before the next rebuild: until then each
             # sphere moves and grows by less than skin/2 together (the test above), and g is
             # a signed distance, so g + s rho rises by less than skin/2 on each wall term
@@ -136,8 +161,15 @@ class Relaxer:
         """Forces (n, 3) and the largest overlap (sphere-sphere or wall penetration)."""
         self.n_force += 1
         p = self._pairs(x, s)
-        F, ov, maxov = self._pair_forces(x, s, p)
-        energy = 0.5 * float(ov @ ov) if ov.size else 0.0
+        fire = self.fire_steps()
+        if fire is not None:
+            if self._F is None or self._F.shape != x.shape:
+                self._F = np.empty_like(x)
+            F = self._F
+            energy, maxov, _ = fire.pair_forces(x, self.rho, s, p, F)
+        else:
+            F, ov, maxov = self._pair_forces(x, s, p)
+            energy = 0.5 * float(ov @ ov) if ov.size else 0.0
         if self.spatial:
             cand = self.wall_candidates
             xw, rad = x[cand], s * self.rho[cand]
@@ -159,9 +191,10 @@ class Relaxer:
         ``stall`` over the last ``window`` steps, or the forces balance with overlaps left)
         or "budget" (max_steps reached). ``progress(step, max_steps, max_overlap)``, if
         given, is called every 50 steps (it prints, or not, as it likes)."""
-        x = x.copy()
+        x = np.array(x, dtype=float, order="C", copy=True)
         v = np.zeros_like(x)
         dt, alpha, n_pos = dt0, 0.1, 0
+        fire = self.fire_steps()
         F, maxov = self.forces(x, s)
         e_hist = []
         for step in range(1, max_steps + 1):
@@ -171,25 +204,37 @@ class Relaxer:
                 e_hist.append(self.energy)
                 if len(e_hist) >= 2 and e_hist[-1] > stall * e_hist[-2]:
                     return x, maxov, "jammed", step
-            fmax = np.sqrt(np.max(np.einsum("ij,ij->i", F, F)))
+            if fire is not None:
+                fmax, P, vn, fn = fire.power(F, v)
+            else:
+                fmax = np.sqrt(np.max(np.einsum("ij,ij->i", F, F)))
             if fmax < 1e-3 * maxov:
                 return x, maxov, "jammed", step
-            P = np.einsum("ij,ij->", F, v)
+            if fire is None:
+                P = np.einsum("ij,ij->", F, v)
             if P > 0:
-                vn = np.sqrt(np.einsum("ij,ij->", v, v))
-                fn = np.sqrt(np.einsum("ij,ij->", F, F))
-                v *= 1 - alpha                  # in place: the same bits, no new arrays
-                v += alpha * vn / max(fn, 1e-300) * F
+                if fire is None:
+                    vn = np.sqrt(np.einsum("ij,ij->", v, v))
+                    fn = np.sqrt(np.einsum("ij,ij->", F, F))
+                a, b = 1 - alpha, alpha * vn / max(fn, 1e-300)       # v = a v + b F
                 n_pos += 1
                 if n_pos > 5:
                     dt = min(dt * 1.1, dt_max)
                     alpha *= 0.99
             else:
-                v[:] = 0.0
+                a, b = 0.0, 0.0
                 dt *= 0.5
                 alpha, n_pos = 0.1, 0
-            v += F * dt
-            x += v * dt
+            if fire is not None:
+                fire.move(x, v, F, a, b, dt)
+            else:
+                if a == 0.0:
+                    v[:] = 0.0
+                else:
+                    v *= a                      # in place: the same bits, no new arrays
+                    v += b * F
+                v += F * dt
+                x += v * dt
             F, maxov = self.forces(x, s)
             if progress is not None and step % 50 == 0:
                 progress(step, max_steps, maxov)
