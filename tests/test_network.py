@@ -576,3 +576,61 @@ def test_deflated_cg_after_value_updates_on_a_lattice_whose_cluster_sums_cancel(
         ref = ConductionProblem(g.n_nodes, g.edges, c2, el, solver="direct").solve()
         np.testing.assert_allclose(sol.potential, ref.potential, rtol=0, atol=1e-8)
         assert sol.info["iterations"] <= cold + 10
+
+
+def test_compiled_deflated_cg_is_the_numpy_one(monkeypatch):
+    """cg-deflated's compiled iterations (native/deflated_cg.cpp, Eigen's Cholesky of the
+    coarse matrix) against its numpy form: the same iterations (+-1), the same solution to
+    the tolerance, cold and after value updates (dense- and sparse-coarse sizes); a matrix
+    that is not positive definite is refused as by numpy; without the helper, numpy."""
+    from yade_electro.network import laplacian
+    from yade_electro.solvers import DeflatedCGSolver
+    import yade_electro.native as native
+    rng = np.random.default_rng(11)
+    for shape in ((6, 6, 24), (14, 14, 40)):        # 54 and 720 clusters: dense and sparse coarse in numpy
+        g = cubic_lattice(shape, 0.5e-3)
+        c = rng.uniform(0.5, 2.0, len(g.edges))
+        L = laplacian(g.edges, c, g.n_nodes).tocsr()
+        # ground the bottom layer: the SPD reduced matrix on the rest
+        keep = np.arange(shape[0] * shape[1], g.n_nodes)
+        A = L[keep][:, keep].tocsr()
+        b = rng.random(keep.size)
+        sol = {}
+        for compiled in (True, False):
+            s = DeflatedCGSolver(native=compiled)
+            s.set_geometry(g.pos[keep], 1e-3)
+            A1 = A.copy()
+            x, info = s.solve(A1, b)
+            assert info["compiled"] is compiled
+            its = [info["iterations"]]
+            xs = [x]
+            for k in range(2):                           # value updates in place, warm re-solves
+                c2 = c * np.random.default_rng(k).uniform(0.99, 1.01, c.size)
+                A2 = laplacian(g.edges, c2, g.n_nodes).tocsr()[keep][:, keep].tocsr()
+                assert np.array_equal(A2.indices, A1.indices)
+                A1.data[:] = A2.data
+                s.update(A1)
+                x, info = s.solve(A1, b, x0=x)
+                its.append(info["iterations"])
+                xs.append(x)
+            sol[compiled] = (its, xs)
+        for a, bb in zip(sol[True][0], sol[False][0]):
+            assert abs(a - bb) <= 1
+        for xa, xb in zip(sol[True][1], sol[False][1]):
+            np.testing.assert_allclose(xa, xb, rtol=0, atol=1e-8 * np.abs(xb).max())
+    # not positive definite: refused like numpy's
+    bad = A.copy()
+    bad.data[bad.indices == np.repeat(np.arange(bad.shape[0]), np.diff(bad.indptr))] *= -1.0
+    s = DeflatedCGSolver()
+    s.set_geometry(g.pos[keep], 1e-3)
+    with pytest.raises(SolverError):
+        s.solve(bad, b)
+
+    class Missing:
+        def __init__(self, *a, **k):
+            raise native.NativeError("not built")
+    monkeypatch.setattr(native, "DeflatedCG", Missing)
+    s = DeflatedCGSolver()
+    s.set_geometry(g.pos[keep], 1e-3)
+    x, info = s.solve(A, b)
+    assert not info["compiled"] and info["residual"] < 1e-10

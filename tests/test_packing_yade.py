@@ -306,6 +306,15 @@ YADE_SCRIPT = textwrap.dedent("""
     out["jcfpm_cohesive"] = all(i.phys.isCohesive for i in real)
     O.run(20, True)
     out["jcfpm_bonds_after"] = sum(1 for i in O.interactions if i.isReal and i.phys.isCohesive)
+    # a large packing's collider sorts along the longest extent (the rod's axis, z): same bonds
+    pairs_x = sorted((min(i.id1, i.id2), max(i.id1, i.id2)) for i in real)
+    O.reset()
+    yade_electro.progress.PROGRESS_EVERY = 10.0
+    import yade_electro.yade.bonding as B
+    B.SORT_ALONG_LONGEST_FROM = 1
+    ids = P.add_bonded_packing(pk, material=JCFpmMat(young=210e9, poisson=0.3, density=7900, cohesion=5e8, tensileStrength=5e8, frictionAngle=0.4), detection_factor=k)
+    out["sort_axis"] = [e.sortAxis for e in O.engines if type(e).__name__ == "InsertionSortCollider"]
+    out["sorted_z_same_bonds"] = sorted((min(i.id1, i.id2), max(i.id1, i.id2)) for i in O.interactions if i.isReal) == pairs_x
     print("RESULT " + json.dumps(out))
 """)
 
@@ -334,6 +343,7 @@ def test_add_bonded_packing_in_yade(tmp_path, rod, cache, yade_exe):
     assert out["tension"] == pytest.approx(out["tension_expected"], rel=1e-6)
     assert out["jcfpm_bonds"] == n_ref and out["jcfpm_cohesive"]
     assert out["jcfpm_bonds_after"] == n_ref
+    assert out["sort_axis"] == [2] and out["sorted_z_same_bonds"]
     # the progress lines of the bonding (shown with PROGRESS_EVERY = 0 in the JCFpm run only)
     progress = [l for l in proc.stderr.splitlines() if l.startswith("[bonding]")]
     assert any(f"{N} of {N}" in l and "spheres added" in l for l in progress), proc.stderr[-2000:]

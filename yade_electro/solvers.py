@@ -143,6 +143,25 @@ class DirectSolver(Solver):
                    "setup": fresh, "setup_time": self.setup_time}
 
 
+def _nonfinite_rhs(name, nb) -> SolverError:
+    return SolverError(f"{name}: the right-hand side is not finite (||b|| = {nb}); check sources and values")
+
+
+def _breakdown(name, pq) -> SolverError:
+    return SolverError(f"{name} broke down (p.Ap = {pq:.3g} <= 0): the matrix is not positive "
+                       "definite; check for negative or non-finite conductances")
+
+
+def _nonfinite_solution(name) -> SolverError:
+    return SolverError(f"{name} produced non-finite values; check conductances for inf/nan")
+
+
+def _check_converged(name, res, nb, rtol, atol, it):
+    if res * nb > 10 * max(rtol * nb, atol):
+        raise SolverError(f"{name} did not converge: relative residual {res:.3e} > rtol {rtol:g} "
+                          f"after {it} iterations; raise maxiter or use solver='direct'")
+
+
 def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
     """Preconditioned CG from ``x`` (modified in place) to ``||r|| <= max(rtol ||b||, atol)``;
     ``deflate`` = (coarse_correct, project) makes it the deflated CG of Saad et al. (2000).
@@ -153,7 +172,7 @@ def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
         x[:] = 0.0
         return x, 0, 0.0
     if not np.isfinite(nb):
-        raise SolverError(f"{name}: the right-hand side is not finite (||b|| = {nb}); check sources and values")
+        raise _nonfinite_rhs(name, nb)
     tol = max(rtol * nb, atol)
     r = b - A @ x
     if np.linalg.norm(r) > nb:
@@ -174,8 +193,7 @@ def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
             q = A @ p
             pq = p @ q
             if not pq > 0:
-                raise SolverError(f"{name} broke down (p.Ap = {pq:.3g} <= 0): the matrix is not positive "
-                                  "definite; check for negative or non-finite conductances")
+                raise _breakdown(name, pq)
             a = rz / pq
             x += a * p
             r -= a * q
@@ -191,7 +209,7 @@ def _pcg(A, b, x, M, rtol, maxiter, name, deflate=None, atol=0.0):
             rz = rz_new
     res = np.linalg.norm(b - A @ x) / nb
     if not np.all(np.isfinite(x)):
-        raise SolverError(f"{name} produced non-finite values; check conductances for inf/nan")
+        raise _nonfinite_solution(name)
     return x, it, res
 
 
@@ -232,6 +250,7 @@ class CGSolver(Solver):
             raise SolverError("the matrix has a non-positive diagonal entry: a node with no conducting edge "
                               "was left among the unknowns")
         inv = 1.0 / d
+        self._inv_diag = inv
         self._M = lambda r: inv * r
 
     def _update(self, A):
@@ -249,10 +268,7 @@ class CGSolver(Solver):
         t = time.perf_counter()
         x, it, res = _pcg(self._Acsr, b, x, self._M, self.rtol, self.maxiter or 10 * n + 10, self.name,
                           self._deflation(), atol)
-        nb = np.linalg.norm(b)
-        if res * nb > 10 * max(self.rtol * nb, atol):
-            raise SolverError(f"{self.name} did not converge: relative residual {res:.3e} > rtol {self.rtol:g} "
-                              f"after {it} iterations; raise maxiter or use solver='direct'")
+        _check_converged(self.name, res, np.linalg.norm(b), self.rtol, atol, it)
         return x, {"solver": self.name, "iterations": it, "residual": res, "setup": fresh,
                    "setup_time": self.setup_time, "iteration_time": time.perf_counter() - t}
 
@@ -273,6 +289,10 @@ class DeflatedCGSolver(CGSolver):
         iterations the extra clusters save: on the lattice rods of ``bench/bench_scale.py``
         at 1M unknowns, 37,044 clusters took 10.9 s (8.2 s of setup, 32 iterations) and
         5,082 took 4.0 s (60 iterations); at 500k, 19,074 took 4.1 s and 2,673 took 1.6 s.
+    native : bool
+        Run the iterations compiled (:class:`yade_electro.native.DeflatedCG`, built on first
+        use; the coarse matrix then factorised by Eigen's sparse Cholesky) instead of numpy
+        (default True; numpy when it cannot be built). The same algorithm; other rounding.
     """
 
     name = "cg-deflated"
@@ -282,8 +302,10 @@ class DeflatedCGSolver(CGSolver):
     DENSE_LIMIT = 400
 
     def __init__(self, rtol: float = 1e-10, maxiter: Optional[int] = None, cluster_size: float = 3.0,
-                 max_clusters: Optional[int] = MAX_CLUSTERS):
+                 max_clusters: Optional[int] = MAX_CLUSTERS, native: bool = True):
         super().__init__(rtol=rtol, preconditioner="jacobi", maxiter=maxiter)
+        self.native = bool(native)
+        self._dcg = None            # the compiled iterations (native.DeflatedCG) of the current setup
         if not cluster_size > 0:
             raise ValueError(f"cluster_size must be > 0, got {cluster_size}")
         if max_clusters is not None and not int(max_clusters) >= 1:
@@ -361,13 +383,32 @@ class DeflatedCGSolver(CGSolver):
         else:
             uek, eslot = np.unique(ekey, return_inverse=True)
         self._e_key, self._e_slot = uek, eslot
+        self._dcg = self._compiled(A, n, k)
         self._coarse_values()
+
+    def _compiled(self, A, n, k):
+        """The compiled iterations for this setup, or None (numpy): not asked for, indices
+        that do not fit int32, or no compiler."""
+        if not self.native or A.indices.dtype != np.int32 or A.indptr.dtype != np.int32:
+            return None
+        from .native import DeflatedCG, NativeError
+        try:
+            return DeflatedCG(n, k)
+        except NativeError as exc:
+            log.info("cg-deflated: the compiled iterations are not available (%s); numpy instead", exc)
+            self.native = False
+            return None
 
     def _coarse_values(self):
         A, k = self._Acsr, self._k
         if self._wta_slot is not None:
             self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
         ev = np.bincount(self._e_slot, A.data, self._e_key.size)
+        if self._dcg is not None and self._WtA.indices.dtype == np.int32:
+            if not self._dcg.factor(self._e_key, ev):
+                raise SolverError("the coarse matrix of 'cg-deflated' is not positive definite (Eigen LLT)")
+            return
+        self._dcg = None
         if k <= self.DENSE_LIMIT:
             # small coarse space: a dense Cholesky factor (LAPACK, no checks in the way)
             E = np.zeros(k * k)
@@ -416,7 +457,26 @@ class DeflatedCGSolver(CGSolver):
         return self._defl
 
     def solve(self, A, b, x0=None, atol: float = 0.0):
-        x, info = super().solve(A, b, x0, atol)
+        fresh = self._ensure_setup(A)
+        if self._dcg is None:
+            x, info = super().solve(A, b, x0, atol)
+        else:
+            b = np.ascontiguousarray(b, dtype=np.float64)
+            nb = np.linalg.norm(b)
+            if not np.isfinite(nb):
+                raise _nonfinite_rhs(self.name, nb)
+            x = np.zeros(b.shape[0]) if x0 is None else np.array(x0, dtype=np.float64, copy=True)
+            t = time.perf_counter()
+            it, res, status = self._dcg.solve(self._Acsr, self._inv_diag, self._lab, self._WtA, b, x, self.rtol,
+                                              atol, self.maxiter or 10 * b.shape[0] + 10)
+            if status == 2:
+                raise _breakdown(self.name, 0.0)
+            if not np.all(np.isfinite(x)):
+                raise _nonfinite_solution(self.name)
+            _check_converged(self.name, res, nb, self.rtol, atol, it)
+            info = {"solver": self.name, "iterations": it, "residual": res, "setup": fresh,
+                    "setup_time": self.setup_time, "iteration_time": time.perf_counter() - t}
+        info["compiled"] = self._dcg is not None
         info["clusters"] = self._k
         info["cluster_size"] = self.cluster_size_used
         return x, info

@@ -39,7 +39,7 @@ from typing import Optional
 import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
-           "FireSteps", "NativeError"]
+           "FireSteps", "DeflatedCG", "NativeError"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -308,3 +308,46 @@ class FireSteps:
                 self._room = int(1.25 * m)
                 return out[:m]
             room = int(1.25 * m)
+
+
+EIGEN_INCLUDE = "/usr/include/eigen3"
+
+
+class DeflatedCG:
+    """The iterations of :class:`yade_electro.solvers.DeflatedCGSolver` compiled
+    (``deflated_cg.cpp``: the same deflated CG, coarse matrix factorised by Eigen's
+    SimplicialLLT), for ``n`` unknowns and ``k`` clusters. Raises :class:`NativeError` when it
+    cannot be built (needs g++ and Eigen's headers, ``libeigen3-dev``)."""
+
+    def __init__(self, n: int, k: int):
+        import ctypes
+        import weakref
+        if not os.path.isdir(EIGEN_INCLUDE):
+            raise NativeError(f"Eigen's headers are missing ({EIGEN_INCLUDE}: apt-get install libeigen3-dev)")
+        i64, ptr, dbl = ctypes.c_int64, ctypes.c_void_p, ctypes.c_double
+
+        def load(symbol, argtypes, restype):
+            return _shared_function("deflated_cg", symbol, argtypes, restype, flags=["-O3", f"-I{EIGEN_INCLUDE}"])
+        create = load("dcg_create", [i64, i64], ptr)
+        destroy = load("dcg_destroy", [ptr], None)
+        self._factor = load("dcg_factor", [ptr, i64, ptr, ptr], ctypes.c_int)
+        self._solve = load("dcg_solve", [ptr] + [ptr] * 10 + [dbl, dbl, i64, ptr], None)
+        self.n, self.k = int(n), int(k)
+        self._h = create(self.n, self.k)
+        self._finalizer = weakref.finalize(self, destroy, self._h)
+        self._out = np.zeros(3)
+
+    def factor(self, key, values) -> bool:
+        """The coarse matrix from its entries (``key`` = row * k + col, int64, the same pattern
+        at every call) and its Cholesky factor; False if it is not positive definite."""
+        key = np.ascontiguousarray(key, dtype=np.int64)
+        values = np.ascontiguousarray(values, dtype=np.float64)
+        return self._factor(self._h, key.size, key.ctypes.data, values.ctypes.data) == 0
+
+    def solve(self, A, inv_diag, lab, WtA, b, x, rtol: float, atol: float, maxiter: int):
+        """Deflated CG on ``A`` (CSR, int32 indices) from ``x`` (float64, in place). Returns
+        (iterations, relative residual, status: 0 done, 2 breakdown)."""
+        arrays = (A.indptr, A.indices, A.data, inv_diag, lab, WtA.indptr, WtA.indices, WtA.data, b, x)
+        self._solve(self._h, *(a.ctypes.data for a in arrays), float(rtol), float(atol), int(maxiter),
+                    self._out.ctypes.data)
+        return int(self._out[0]), float(self._out[1]), int(self._out[2])

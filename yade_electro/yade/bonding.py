@@ -23,6 +23,11 @@ log = logging.getLogger(__name__)
 #: spheres added to ``O.bodies`` per call (a progress line can come between two)
 APPEND_CHUNK = 20000
 
+#: from this many spheres on, the collider sorts along the packing's longest extent (YADE's
+#: default is x). Below, x as before: the order of YADE's interactions, and so of the graph's
+#: edges, stays what the figures of the cases were made with.
+SORT_ALONG_LONGEST_FROM = 200_000
+
 
 def _step_showing_progress(O, progress: Progress, note: str) -> None:
     """One ``O.step()``, run in YADE's background thread so that a long one (the collider's
@@ -139,6 +144,11 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
     progress.done()
     bo1 = W.Bo1_Sphere_Aabb(aabbEnlargeFactor=k)
     collider = W.InsertionSortCollider([bo1])
+    if n_spheres >= SORT_ALONG_LONGEST_FROM:
+        # the collider's first sweep checks every pair whose bounds overlap along its sort axis:
+        # along the packing's longest extent there are fewest (a 200k rod, 2 x 5 mm: 38 -> 14 s)
+        extent = packing.centers.max(axis=0) - packing.centers.min(axis=0)
+        collider.sortAxis = int(np.argmax(extent))
     # The cohesive law itself runs during the bonding step (YADE's InteractionLoop keeps the law
     # functor it first used for an interaction: a stand-in law would stay in use for the bonds).
     # With CohFrictMat it must not break the bonds across gaps before their reference distance
