@@ -156,6 +156,11 @@ def _nonfinite_solution(name) -> SolverError:
     return SolverError(f"{name} produced non-finite values; check conductances for inf/nan")
 
 
+def _nonpositive_diagonal() -> SolverError:
+    return SolverError("the matrix has a non-positive diagonal entry: a node with no conducting edge "
+                       "was left among the unknowns")
+
+
 def _check_converged(name, res, nb, rtol, atol, it):
     if res * nb > 10 * max(rtol * nb, atol):
         raise SolverError(f"{name} did not converge: relative residual {res:.3e} > rtol {rtol:g} "
@@ -247,8 +252,7 @@ class CGSolver(Solver):
             return
         d = self._Acsr.diagonal()
         if np.any(d <= 0):
-            raise SolverError("the matrix has a non-positive diagonal entry: a node with no conducting edge "
-                              "was left among the unknowns")
+            raise _nonpositive_diagonal()
         inv = 1.0 / d
         self._inv_diag = inv
         self._M = lambda r: inv * r
@@ -391,21 +395,37 @@ class DeflatedCGSolver(CGSolver):
         that do not fit int32, or no compiler."""
         if not self.native or A.indices.dtype != np.int32 or A.indptr.dtype != np.int32:
             return None
+        # where each row's diagonal sits in A.data (the compiled refill reads it there)
+        rows = np.repeat(np.arange(n), np.diff(A.indptr))
+        diag_pos = np.flatnonzero(A.indices == rows)
+        if diag_pos.size != n or not np.array_equal(rows[diag_pos], np.arange(n)):
+            return None
         from .native import DeflatedCG, NativeError
         try:
-            return DeflatedCG(n, k)
+            dcg = DeflatedCG(n, k)
         except NativeError as exc:
             log.info("cg-deflated: the compiled iterations are not available (%s); numpy instead", exc)
             self.native = False
             return None
+        dcg.coarse_pattern(self._e_key)
+        self._diag_pos = diag_pos.astype(np.int64)
+        return dcg
 
     def _coarse_values(self):
         A, k = self._Acsr, self._k
+        if self._dcg is not None and self._wta_slot is not None and self._WtA.indices.dtype == np.int32:
+            # compiled: the diagonal, W^T A and E's values in one pass, then E's factor
+            status = self._dcg.refill(A, self._diag_pos, self._inv_diag, self._wta_slot, self._WtA, self._e_slot)
+            if status == 2:
+                raise _nonpositive_diagonal()
+            if status == 1:
+                raise SolverError("the coarse matrix of 'cg-deflated' is not positive definite (Eigen LLT)")
+            return
         if self._wta_slot is not None:
             self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
         ev = np.bincount(self._e_slot, A.data, self._e_key.size)
         if self._dcg is not None and self._WtA.indices.dtype == np.int32:
-            if not self._dcg.factor(self._e_key, ev):
+            if not self._dcg.factor(ev):
                 raise SolverError("the coarse matrix of 'cg-deflated' is not positive definite (Eigen LLT)")
             return
         self._dcg = None
@@ -438,7 +458,8 @@ class DeflatedCGSolver(CGSolver):
         self._defl = (coarse, project)
 
     def _update(self, A):
-        self._set_diagonal()
+        if self._dcg is None or self._wta_slot is None:
+            self._set_diagonal()            # (the compiled refill does it otherwise)
         if self._wta_slot is None:
             # the structural pattern of W^T A (no cancellation: a product of ones) and the
             # entry (lab_i, j) each non-zero (i, j) of A adds to, by a binary search among its

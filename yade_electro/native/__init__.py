@@ -330,19 +330,36 @@ class DeflatedCG:
             return _shared_function("deflated_cg", symbol, argtypes, restype, flags=["-O3", f"-I{EIGEN_INCLUDE}"])
         create = load("dcg_create", [i64, i64], ptr)
         destroy = load("dcg_destroy", [ptr], None)
-        self._factor = load("dcg_factor", [ptr, i64, ptr, ptr], ctypes.c_int)
+        self._pattern = load("dcg_coarse_pattern", [ptr, i64, ptr], None)
+        self._factor = load("dcg_factor", [ptr, ptr], ctypes.c_int)
+        self._refill = load("dcg_refill", [ptr, i64, ptr, ptr, ptr, ptr, i64, ptr, ptr], ctypes.c_int)
         self._solve = load("dcg_solve", [ptr] + [ptr] * 10 + [dbl, dbl, i64, ptr], None)
         self.n, self.k = int(n), int(k)
         self._h = create(self.n, self.k)
         self._finalizer = weakref.finalize(self, destroy, self._h)
         self._out = np.zeros(3)
 
-    def factor(self, key, values) -> bool:
-        """The coarse matrix from its entries (``key`` = row * k + col, int64, the same pattern
-        at every call) and its Cholesky factor; False if it is not positive definite."""
+    def coarse_pattern(self, key):
+        """The pattern of the coarse matrix: ``key`` = row * k + col (int64) of its entries."""
         key = np.ascontiguousarray(key, dtype=np.int64)
+        self._pattern(self._h, key.size, key.ctypes.data)
+        self._m = key.size
+
+    def factor(self, values) -> bool:
+        """The coarse matrix's values on :meth:`coarse_pattern` and its Cholesky factor; False
+        if it is not positive definite."""
         values = np.ascontiguousarray(values, dtype=np.float64)
-        return self._factor(self._h, key.size, key.ctypes.data, values.ctypes.data) == 0
+        if values.size != self._m:
+            raise ValueError(f"expected {self._m} coarse values, got {values.size}")
+        return self._factor(self._h, values.ctypes.data) == 0
+
+    def refill(self, A, diag_pos, inv_diag, wta_slot, WtA, e_slot) -> int:
+        """New values of ``A`` (same pattern): ``inv_diag`` (1 / its diagonal, at ``diag_pos``
+        in ``A.data``), ``WtA.data`` (non-zero t of A adds to ``wta_slot[t]``), the coarse
+        values (to ``e_slot[t]``) and their factor, in one compiled pass. Returns 0, 1 (the
+        coarse matrix is not positive definite) or 2 (a diagonal entry <= 0)."""
+        return self._refill(self._h, A.nnz, A.data.ctypes.data, diag_pos.ctypes.data, inv_diag.ctypes.data,
+                            wta_slot.ctypes.data, WtA.nnz, WtA.data.ctypes.data, e_slot.ctypes.data)
 
     def solve(self, A, inv_diag, lab, WtA, b, x, rtol: float, atol: float, maxiter: int):
         """Deflated CG on ``A`` (CSR, int32 indices) from ``x`` (float64, in place). Returns

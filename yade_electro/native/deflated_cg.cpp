@@ -8,6 +8,7 @@
 // A: n x n CSR (int32 indptr/indices), W^T A: k x n CSR, lab: cluster of each unknown (int64).
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -22,6 +23,8 @@ struct Handle {
     Eigen::SimplicialLLT<SpMat> llt;
     bool analyzed = false;
     std::vector<Eigen::Triplet<double>> triplets;
+    std::vector<int64_t> e_row, e_col;       // E's pattern (dcg_coarse_pattern)
+    std::vector<double> e_val;
     Eigen::VectorXd cv, cy;                 // coarse vectors
     std::vector<double> r, z, p, q;
 };
@@ -58,13 +61,23 @@ extern "C" void* dcg_create(int64_t n, int64_t k) {
 
 extern "C" void dcg_destroy(void* handle) { delete static_cast<Handle*>(handle); }
 
-// E's entries (key = row * k + col, the same pattern at every call) and its Cholesky factor.
-// Returns 0, or 1 when E is not positive definite.
-extern "C" int dcg_factor(void* handle, int64_t m, const int64_t* key, const double* val) {
+// The pattern of E (key = row * k + col) for dcg_refill, kept in the handle.
+extern "C" void dcg_coarse_pattern(void* handle, int64_t m, const int64_t* key) {
     Handle* h = static_cast<Handle*>(handle);
+    h->e_row.resize(m);
+    h->e_col.resize(m);
+    h->e_val.resize(m);
+    for (int64_t t = 0; t < m; ++t) {
+        h->e_row[t] = key[t] / h->k;
+        h->e_col[t] = key[t] % h->k;
+    }
+}
+
+static int factor_values(Handle* h) {
+    const int64_t m = (int64_t)h->e_val.size();
     h->triplets.clear();
     h->triplets.reserve(m);
-    for (int64_t t = 0; t < m; ++t) h->triplets.emplace_back(key[t] / h->k, key[t] % h->k, val[t]);
+    for (int64_t t = 0; t < m; ++t) h->triplets.emplace_back(h->e_row[t], h->e_col[t], h->e_val[t]);
     h->E.setFromTriplets(h->triplets.begin(), h->triplets.end());
     if (!h->analyzed) {
         h->llt.analyzePattern(h->E);
@@ -72,6 +85,35 @@ extern "C" int dcg_factor(void* handle, int64_t m, const int64_t* key, const dou
     }
     h->llt.factorize(h->E);
     return h->llt.info() == Eigen::Success ? 0 : 1;
+}
+
+// New values of A (same pattern): the Jacobi inverse diagonal (diag_pos: where each row's
+// diagonal sits in a), the values of W^T A (each non-zero t of A adds to wta[wta_slot[t]]) and of
+// E (to its entry e_slot[t]), then E's factor. The bincounts of the numpy form, in one pass.
+// Returns 0, 1 (E not positive definite) or 2 (a diagonal entry <= 0: inv_d is then not complete).
+extern "C" int dcg_refill(void* handle, int64_t nnz, const double* a, const int64_t* diag_pos, double* inv_d,
+                          const int64_t* wta_slot, int64_t wta_nnz, double* wta, const int64_t* e_slot) {
+    Handle* h = static_cast<Handle*>(handle);
+    for (int64_t i = 0; i < h->n; ++i) {
+        const double d = a[diag_pos[i]];
+        if (!(d > 0.0)) return 2;
+        inv_d[i] = 1.0 / d;
+    }
+    std::fill(wta, wta + wta_nnz, 0.0);
+    std::fill(h->e_val.begin(), h->e_val.end(), 0.0);
+    for (int64_t t = 0; t < nnz; ++t) {
+        wta[wta_slot[t]] += a[t];
+        h->e_val[e_slot[t]] += a[t];
+    }
+    return factor_values(h);
+}
+
+// E's values on the pattern of dcg_coarse_pattern and its Cholesky factor. Returns 0, or 1 when E
+// is not positive definite.
+extern "C" int dcg_factor(void* handle, const double* val) {
+    Handle* h = static_cast<Handle*>(handle);
+    std::copy(val, val + h->e_val.size(), h->e_val.begin());
+    return factor_values(h);
 }
 
 // Solve A x = b from x (in place) to ||b - A x|| <= max(rtol ||b||, atol). out = [iterations,
