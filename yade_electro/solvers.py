@@ -376,8 +376,6 @@ class DeflatedCGSolver(CGSolver):
         # update makes the structural pattern (the product with |A|'s pattern) and where each
         # non-zero of A goes in it; updates then refill it in place by a bincount
         self._Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
-        self._WtA = self._Wt @ A
-        self._wta_slot = None
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
         if k * k <= 50_000_000:          # the keys fit a count: the same sorted keys, no sort of nnz
@@ -388,6 +386,14 @@ class DeflatedCGSolver(CGSolver):
             uek, eslot = np.unique(ekey, return_inverse=True)
         self._e_key, self._e_slot = uek, eslot
         self._dcg = self._compiled(A, n, k)
+        if self._dcg is not None:
+            # compiled: W^T A's structural pattern and each non-zero's entry in it at once (one
+            # pass over A), so that every value update, the first too, is a refill
+            indptr, indices, self._wta_slot = self._dcg.wta_pattern(A, lab)
+            self._WtA = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=(k, n))
+        else:
+            self._WtA = self._Wt @ A
+            self._wta_slot = None
         self._coarse_values()
 
     def _compiled(self, A, n, k):

@@ -331,6 +331,7 @@ class DeflatedCG:
         create = load("dcg_create", [i64, i64], ptr)
         destroy = load("dcg_destroy", [ptr], None)
         self._pattern = load("dcg_coarse_pattern", [ptr, i64, ptr], None)
+        self._wta_pattern = load("dcg_wta_pattern", [i64, i64, ptr, ptr, ptr, ptr, ptr, ptr], i64)
         self._factor = load("dcg_factor", [ptr, ptr], ctypes.c_int)
         self._refill = load("dcg_refill", [ptr, i64, ptr, ptr, ptr, ptr, i64, ptr, ptr], ctypes.c_int)
         self._solve = load("dcg_solve", [ptr] + [ptr] * 10 + [dbl, dbl, i64, ptr], None)
@@ -338,6 +339,18 @@ class DeflatedCG:
         self._h = create(self.n, self.k)
         self._finalizer = weakref.finalize(self, destroy, self._h)
         self._out = np.zeros(3)
+
+    def wta_pattern(self, A, lab):
+        """The structural pattern of W^T A (``indptr``, ``indices`` int32; columns unsorted
+        within a row) and ``slot`` (int64): the entry of W^T A each non-zero of ``A`` (CSR,
+        int32) adds to, for the clusters ``lab`` (int64) of the rows."""
+        lab = np.ascontiguousarray(lab, dtype=np.int64)
+        indptr = np.empty(self.k + 1, dtype=np.int32)
+        indices = np.empty(A.nnz, dtype=np.int32)
+        slot = np.empty(A.nnz, dtype=np.int64)
+        m = self._wta_pattern(self.n, self.k, A.indptr.ctypes.data, A.indices.ctypes.data, lab.ctypes.data,
+                              indptr.ctypes.data, indices.ctypes.data, slot.ctypes.data)
+        return indptr, indices[:m].copy(), slot
 
     def coarse_pattern(self, key):
         """The pattern of the coarse matrix: ``key`` = row * k + col (int64) of its entries."""

@@ -61,6 +61,38 @@ extern "C" void* dcg_create(int64_t n, int64_t k) {
 
 extern "C" void dcg_destroy(void* handle) { delete static_cast<Handle*>(handle); }
 
+// The structural pattern of W^T A (k x n CSR: row c holds every column j with a non-zero (i, j) of A,
+// lab[i] = c; columns in the order first met, not sorted) and the entry each non-zero t of A adds
+// to (slot[t]), by one pass over A's rows grouped by cluster. out_indices needs room for nnz
+// entries. Returns the number of non-zeros of W^T A.
+extern "C" int64_t dcg_wta_pattern(int64_t n, int64_t k, const int32_t* ip, const int32_t* ix, const int64_t* lab,
+                                   int32_t* out_indptr, int32_t* out_indices, int64_t* slot) {
+    std::vector<int64_t> count(k + 1, 0), rows(n);
+    for (int64_t i = 0; i < n; ++i) ++count[lab[i] + 1];
+    for (int64_t c = 0; c < k; ++c) count[c + 1] += count[c];
+    std::vector<int64_t> fill(count.begin(), count.end() - 1);
+    for (int64_t i = 0; i < n; ++i) rows[fill[lab[i]]++] = i;         // rows grouped by cluster
+    std::vector<int64_t> mark(n, -1), where(n, 0);
+    int64_t m = 0;
+    out_indptr[0] = 0;
+    for (int64_t c = 0; c < k; ++c) {
+        for (int64_t r = count[c]; r < count[c + 1]; ++r) {
+            const int64_t i = rows[r];
+            for (int32_t t = ip[i]; t < ip[i + 1]; ++t) {
+                const int32_t j = ix[t];
+                if (mark[j] != c) {
+                    mark[j] = c;
+                    where[j] = m;
+                    out_indices[m++] = j;
+                }
+                slot[t] = where[j];
+            }
+        }
+        out_indptr[c + 1] = (int32_t)m;
+    }
+    return m;
+}
+
 // The pattern of E (key = row * k + col) for dcg_refill, kept in the handle.
 extern "C" void dcg_coarse_pattern(void* handle, int64_t m, const int64_t* key) {
     Handle* h = static_cast<Handle*>(handle);
