@@ -1077,8 +1077,8 @@ class HeatSolver:
         the current temperatures when ``apply`` (the clock does not move). Raises ThermalError
         when some part of the network has no fixed temperature and no convection.
 
-        The linear solver is 'cg' (Jacobi) below 2,000 unknowns and 'cg-deflated' above it,
-        kept across calls, to ``rtol`` relative residual."""
+        The linear solver is ``'auto'`` (:func:`yade_electro.solvers.auto_solver_name`: the
+        deflated CG from 80 unknowns on), kept across calls, to ``rtol`` relative residual."""
         n = self.n
         src = np.zeros(n) if sources is None else np.asarray(sources, dtype=float)
         if src.shape != (n,) or not np.all(np.isfinite(src)):
