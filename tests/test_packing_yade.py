@@ -372,3 +372,25 @@ def test_yade_predicate_import_path():
     pts = np.array([[0, 0, 0.5], [0.49, 0, 0.01], [0.45, 0, 0.5], [0, 0, 1.2]])
     expect = np.array([hyp(tuple(p), 0) for p in pts])
     assert np.array_equal(g.sdf(pts) <= 0, expect)
+
+
+def test_fire_steps_threads_follow_yade_batch_jobs(monkeypatch):
+    """The compiled FIRE steps use 2 threads on a 2-core machine, also under plain yade (which
+    sets OMP_NUM_THREADS=1 for itself); in a yade-batch job (YADE_BATCH set) the job's
+    OMP_NUM_THREADS, so that parallel jobs do not oversubscribe; YADE_ELECTRO_THREADS wins."""
+    import yade_electro.native as native
+    monkeypatch.setattr(native.os, "cpu_count", lambda: 2)
+    for name in ("OMP_NUM_THREADS", "YADE_BATCH", "YADE_ELECTRO_THREADS"):
+        monkeypatch.delenv(name, raising=False)
+    assert native.default_threads() == 2
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    assert native.default_threads() == 2                  # plain yade's own setting
+    monkeypatch.setenv("YADE_BATCH", "")
+    assert native.default_threads() == 1 and native.FireSteps().threads == 1
+    monkeypatch.setenv("OMP_NUM_THREADS", "8")
+    assert native.default_threads() == 2
+    monkeypatch.setenv("YADE_ELECTRO_THREADS", "1")
+    assert native.default_threads() == 1
+    monkeypatch.delenv("YADE_ELECTRO_THREADS")
+    monkeypatch.setattr(native.os, "cpu_count", lambda: 1)
+    assert native.default_threads() == 1

@@ -235,6 +235,23 @@ def soft_sphere_forces(x, rho, s: float, pairs):
     return F, ov[:m], float(mx.value)
 
 
+def default_threads() -> int:
+    """Threads of the compiled helpers that use more than one (1 or 2): ``YADE_ELECTRO_THREADS``
+    when set; in a yade-batch job (``YADE_BATCH`` in the environment) the job's threads
+    (``OMP_NUM_THREADS``, which yade-batch sets per job), so that parallel jobs do not
+    oversubscribe the cores; otherwise the machine's cores. At most 2. (Plain ``yade`` sets
+    OMP_NUM_THREADS = 1 for its own loops by default: that is not read as a limit here.)"""
+    def count(name):
+        v = os.environ.get(name, "").strip()
+        return int(v) if v.isdigit() and int(v) >= 1 else None
+    n = os.cpu_count() or 1
+    if count("YADE_ELECTRO_THREADS") is not None:
+        n = count("YADE_ELECTRO_THREADS")
+    elif "YADE_BATCH" in os.environ:
+        n = min(n, count("OMP_NUM_THREADS") or 1)
+    return max(1, min(2, n))
+
+
 class FireSteps:
     """The compiled vector work of one FIRE step of the jamming (``fire_steps.cpp``), for large
     packings in spatial order (:data:`yade_electro.packing.jamming.SPATIAL_ORDER_FROM`): one
@@ -242,9 +259,9 @@ class FireSteps:
     the numpy form. Raises :class:`NativeError` when the helper cannot be built.
 
     Arrays: ``x``, ``v``, ``F`` (n, 3) float64 C-contiguous (``F`` and ``v`` are written in
-    place), ``rho`` (n,), ``pairs`` (p, 2) int64. ``threads`` (1 or 2, default 2 where the
-    machine has two cores): the pair forces from 100,000 pairs on are split in two halves,
-    one per thread."""
+    place), ``rho`` (n,), ``pairs`` (p, 2) int64. ``threads`` (1 or 2, default
+    :func:`default_threads`: 2 on two cores, a yade-batch job's own threads): the pair forces
+    from 100,000 pairs on are split in two halves, one per thread."""
 
     def __init__(self, threads: Optional[int] = None):
         import ctypes
@@ -257,8 +274,9 @@ class FireSteps:
         self._move = load("fire_move", [i64, ptr, ptr, ptr, dbl, dbl, dbl], None)
         self._max_move2 = load("fire_max_move2", [i64, ptr, ptr], dbl)
         self._pairs_within = load("fire_pairs_within", [i64, ptr, dbl, i64, ptr], i64)
-        # the pair forces on two threads (the pairs in two halves) where there are two cores
-        self.threads = min(2, os.cpu_count() or 1) if threads is None else max(1, min(2, int(threads)))
+        # the pair forces on two threads (the pairs in two halves) where there are two cores and
+        # the process may use them (see default_threads)
+        self.threads = default_threads() if threads is None else max(1, min(2, int(threads)))
         self._out = np.zeros(4)
         self._room = 0
 
