@@ -373,11 +373,6 @@ class DeflatedCGSolver(CGSolver):
         self._lab, self._k = lab, k
         rows = np.repeat(np.arange(n), np.diff(A.indptr))
         cols = A.indices
-        # W^T A (k x n): one sparse product with W^T (scipy's, in C; a sort of one key per
-        # non-zero here cost more than the iterations at 5,000 unknowns). The product drops
-        # entries that cancel (a cluster's column sum can be exactly 0), so the first value
-        # update makes the structural pattern (the product with |A|'s pattern) and where each
-        # non-zero of A goes in it; updates then refill it in place by a bincount
         self._Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
@@ -395,6 +390,12 @@ class DeflatedCGSolver(CGSolver):
             indptr, indices, self._wta_slot = self._dcg.wta_pattern(A, lab)
             self._WtA = sp.csr_matrix((np.zeros(indices.size), indices, indptr), shape=(k, n))
         else:
+            # numpy: W^T A (k x n) by one sparse product with W^T (scipy's, in C; a sort of one
+            # key per non-zero here cost more than the iterations at 5,000 unknowns). The
+            # product drops entries that cancel (a cluster's column sum can be exactly 0), so
+            # the first value update makes the structural pattern (the product with |A|'s
+            # pattern) and where each non-zero of A goes in it; updates then refill it in place
+            # by a bincount
             self._WtA = self._Wt @ A
             self._wta_slot = None
         self._coarse_values()
@@ -422,7 +423,7 @@ class DeflatedCGSolver(CGSolver):
 
     def _coarse_values(self):
         A, k = self._Acsr, self._k
-        if self._dcg is not None and self._wta_slot is not None and self._WtA.indices.dtype == np.int32:
+        if self._dcg is not None:
             # compiled: the diagonal, W^T A and E's values in one pass, then E's factor
             status = self._dcg.refill(A, self._diag_pos, self._inv_diag, self._wta_slot, self._WtA, self._e_slot)
             if status == 2:
@@ -433,11 +434,6 @@ class DeflatedCGSolver(CGSolver):
         if self._wta_slot is not None:
             self._WtA.data[:] = np.bincount(self._wta_slot, A.data, self._WtA.nnz)
         ev = np.bincount(self._e_slot, A.data, self._e_key.size)
-        if self._dcg is not None and self._WtA.indices.dtype == np.int32:
-            if not self._dcg.factor(ev):
-                raise SolverError("the coarse matrix of 'cg-deflated' is not positive definite (Eigen LLT)")
-            return
-        self._dcg = None
         if k <= self.DENSE_LIMIT:
             # small coarse space: a dense Cholesky factor (LAPACK, no checks in the way)
             E = np.zeros(k * k)
@@ -467,7 +463,7 @@ class DeflatedCGSolver(CGSolver):
         self._defl = (coarse, project)
 
     def _update(self, A):
-        if self._dcg is None or self._wta_slot is None:
+        if self._dcg is None:
             self._set_diagonal()            # (the compiled refill does it otherwise)
         if self._wta_slot is None:
             # the structural pattern of W^T A (no cancellation: a product of ones) and the
@@ -500,7 +496,7 @@ class DeflatedCGSolver(CGSolver):
             it, res, status = self._dcg.solve(self._Acsr, self._inv_diag, self._lab, self._WtA, b, x, self.rtol,
                                               atol, self.maxiter or 10 * b.shape[0] + 10)
             if status == 2:
-                raise _breakdown(self.name, 0.0)
+                raise _breakdown(self.name, res)        # (res is then p.Ap)
             if not np.all(np.isfinite(x)):
                 raise _nonfinite_solution(self.name)
             _check_converged(self.name, res, nb, self.rtol, atol, it)

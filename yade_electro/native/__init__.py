@@ -350,7 +350,6 @@ class DeflatedCG:
         destroy = load("dcg_destroy", [ptr], None)
         self._pattern = load("dcg_coarse_pattern", [ptr, i64, ptr], None)
         self._wta_pattern = load("dcg_wta_pattern", [i64, i64, ptr, ptr, ptr, ptr, ptr, ptr], i64)
-        self._factor = load("dcg_factor", [ptr, ptr], ctypes.c_int)
         self._refill = load("dcg_refill", [ptr, i64, ptr, ptr, ptr, ptr, i64, ptr, ptr], ctypes.c_int)
         self._solve = load("dcg_solve", [ptr] + [ptr] * 10 + [dbl, dbl, i64, ptr], None)
         self.n, self.k = int(n), int(k)
@@ -374,15 +373,6 @@ class DeflatedCG:
         """The pattern of the coarse matrix: ``key`` = row * k + col (int64) of its entries."""
         key = np.ascontiguousarray(key, dtype=np.int64)
         self._pattern(self._h, key.size, key.ctypes.data)
-        self._m = key.size
-
-    def factor(self, values) -> bool:
-        """The coarse matrix's values on :meth:`coarse_pattern` and its Cholesky factor; False
-        if it is not positive definite."""
-        values = np.ascontiguousarray(values, dtype=np.float64)
-        if values.size != self._m:
-            raise ValueError(f"expected {self._m} coarse values, got {values.size}")
-        return self._factor(self._h, values.ctypes.data) == 0
 
     def refill(self, A, diag_pos, inv_diag, wta_slot, WtA, e_slot) -> int:
         """New values of ``A`` (same pattern): ``inv_diag`` (1 / its diagonal, at ``diag_pos``
@@ -394,7 +384,8 @@ class DeflatedCG:
 
     def solve(self, A, inv_diag, lab, WtA, b, x, rtol: float, atol: float, maxiter: int):
         """Deflated CG on ``A`` (CSR, int32 indices) from ``x`` (float64, in place). Returns
-        (iterations, relative residual, status: 0 done, 2 breakdown)."""
+        (iterations, relative residual, status: 0 done, 2 breakdown: p.Ap <= 0, given in place
+        of the residual)."""
         arrays = (A.indptr, A.indices, A.data, inv_diag, lab, WtA.indptr, WtA.indices, WtA.data, b, x)
         self._solve(self._h, *(a.ctypes.data for a in arrays), float(rtol), float(atol), int(maxiter),
                     self._out.ctypes.data)

@@ -140,17 +140,9 @@ extern "C" int dcg_refill(void* handle, int64_t nnz, const double* a, const int6
     return factor_values(h);
 }
 
-// E's values on the pattern of dcg_coarse_pattern and its Cholesky factor. Returns 0, or 1 when E
-// is not positive definite.
-extern "C" int dcg_factor(void* handle, const double* val) {
-    Handle* h = static_cast<Handle*>(handle);
-    std::copy(val, val + h->e_val.size(), h->e_val.begin());
-    return factor_values(h);
-}
-
 // Solve A x = b from x (in place) to ||b - A x|| <= max(rtol ||b||, atol). out = [iterations,
 // relative residual ||b - A x|| / ||b||, status]: status 0 done (the caller checks the residual),
-// 2 breakdown (p.Ap <= 0: A not positive definite).
+// 2 breakdown (p.Ap <= 0: A not positive definite; out[1] is then p.Ap).
 extern "C" void dcg_solve(void* handle, const int32_t* ip, const int32_t* ix, const double* a, const double* inv_d,
                           const int64_t* lab, const int32_t* wip, const int32_t* wix, const double* wa, const double* b,
                           double* x, double rtol, double atol, int64_t maxiter, double* out) {
@@ -206,6 +198,7 @@ extern "C" void dcg_solve(void* handle, const int32_t* ip, const int32_t* ix, co
             const double pq = dot(n, p, q);
             if (!(pq > 0.0)) {
                 out[0] = (double)it;
+                out[1] = pq;
                 out[2] = 2.0;
                 return;
             }
