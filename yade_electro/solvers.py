@@ -373,7 +373,6 @@ class DeflatedCGSolver(CGSolver):
         self._lab, self._k = lab, k
         rows = np.repeat(np.arange(n), np.diff(A.indptr))
         cols = A.indices
-        self._Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
         # E = W^T A W (k x k): each non-zero (i, j) adds to (lab_i, lab_j)
         ekey = lab[rows] * k + lab[cols]
         if k * k <= 50_000_000:          # the keys fit a count: the same sorted keys, no sort of nnz
@@ -383,7 +382,7 @@ class DeflatedCGSolver(CGSolver):
         else:
             uek, eslot = np.unique(ekey, return_inverse=True)
         self._e_key, self._e_slot = uek, eslot
-        self._dcg = self._compiled(A, n, k)
+        self._dcg = self._compiled(A, n, k, rows)
         if self._dcg is not None:
             # compiled: W^T A's structural pattern and each non-zero's entry in it at once (one
             # pass over A), so that every value update, the first too, is a refill
@@ -396,17 +395,17 @@ class DeflatedCGSolver(CGSolver):
             # the first value update makes the structural pattern (the product with |A|'s
             # pattern) and where each non-zero of A goes in it; updates then refill it in place
             # by a bincount
+            self._Wt = sp.csr_matrix((np.ones(n), (lab, np.arange(n))), shape=(k, n))
             self._WtA = self._Wt @ A
             self._wta_slot = None
         self._coarse_values()
 
-    def _compiled(self, A, n, k):
+    def _compiled(self, A, n, k, rows):
         """The compiled iterations for this setup, or None (numpy): not asked for, indices
-        that do not fit int32, or no compiler."""
+        that do not fit int32, or no compiler. ``rows``: the row of each non-zero of A."""
         if not self.native or A.indices.dtype != np.int32 or A.indptr.dtype != np.int32:
             return None
         # where each row's diagonal sits in A.data (the compiled refill reads it there)
-        rows = np.repeat(np.arange(n), np.diff(A.indptr))
         diag_pos = np.flatnonzero(A.indices == rows)
         if diag_pos.size != n or not np.array_equal(rows[diag_pos], np.arange(n)):
             return None
