@@ -634,3 +634,19 @@ def test_compiled_deflated_cg_is_the_numpy_one(monkeypatch):
     s.set_geometry(g.pos[keep], 1e-3)
     x, info = s.solve(A, b)
     assert not info["compiled"] and info["residual"] < 1e-10
+
+
+def test_compiled_deflated_cg_refuses_an_indefinite_matrix():
+    """A symmetric matrix with a positive diagonal that is not positive definite: the compiled
+    deflated CG says so (coarse factor or breakdown), as numpy's does, instead of a NaN."""
+    from yade_electro.solvers import DeflatedCGSolver
+    n = 200
+    rng = np.random.default_rng(3)
+    coords = rng.random((n, 3))
+    # 1 on the diagonal, -2 between neighbours in a chain: eigenvalues down to 1 - 4 < 0
+    A = sp.diags([np.full(n - 1, -2.0), np.ones(n), np.full(n - 1, -2.0)], [-1, 0, 1], format="csr")
+    for native in (True, False):
+        s = DeflatedCGSolver(native=native, cluster_size=1.0)
+        s.set_geometry(coords, 0.05)
+        with pytest.raises(SolverError, match="not positive definite"):
+            s.solve(A, rng.random(n))
