@@ -557,6 +557,40 @@ def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
                                        rtol=1e-13, atol=1e-13)
 
 
+@pytest.mark.parametrize("repeats", [False, True])
+def test_compiled_laplacian_fill_is_the_numpy_one(repeats, monkeypatch):
+    """ReducedSystem's compiled K_uu fill (native/laplacian_fill.cpp) gives numpy's values to
+    the last bit, with and without an extra diagonal, for distinct and repeated edges;
+    K_ud and K_dd are the same; without the helper it falls back to numpy."""
+    from yade_electro.condensation import ReducedSystem
+    import yade_electro.native as native
+    rng = np.random.default_rng(3 + repeats)
+    n = 400
+    e = np.sort(rng.integers(0, n, (1500, 2)), axis=1)
+    e = np.unique(e[e[:, 0] != e[:, 1]], axis=0)
+    if repeats:
+        e = np.concatenate([e, e[::5]])
+    groups = [np.arange(0, 7), np.arange(50, 60)]
+    fast, slow = ReducedSystem(n, e, groups), ReducedSystem(n, e, groups, native=False)
+    for extra in (None, rng.random(fast.n_unknowns), 2.5):
+        c = rng.random(len(e))
+        fast.assemble(c, extra)
+        slow.assemble(c, extra)
+        assert fast.compiled is True and slow.compiled is None
+        assert np.array_equal(fast.Kuu.data, slow.Kuu.data)
+        assert np.array_equal(fast.Kud.data, slow.Kud.data) and np.array_equal(fast.Kdd.data, slow.Kdd.data)
+    with pytest.raises(ValueError, match="one value per edge"):
+        fast.assemble(np.ones(len(e) + 1))
+
+    def unavailable(*a, **k):
+        raise native.NativeError("no compiler here")
+    monkeypatch.setattr(native, "laplacian_fill", unavailable)
+    other = ReducedSystem(n, e, groups)
+    other.assemble(c)
+    slow.assemble(c)
+    assert other.compiled is False and np.array_equal(other.Kuu.data, slow.Kuu.data)
+
+
 def test_deflated_cg_after_value_updates_on_a_lattice_whose_cluster_sums_cancel():
     """Uniform conductances on a lattice make many entries of the deflation's W^T A exactly 0
     (a cluster's column sum of the Laplacian); after value updates the solver must still

@@ -20,6 +20,12 @@ written executable.
 3-hop test of every Voronoi face in 0.24 s, where the sparse-matrix powers (the fallback
 without g++) took about 10 s and 1 GB.
 
+``laplacian_fill``: the values of a condensed Laplacian's unknown block from new edge values
+(:func:`laplacian_fill`, used by :class:`yade_electro.condensation.ReducedSystem`), numpy's
+operations in one pass, the same values to the last bit; measured on the rod problems in
+one process, 0.17 against 0.36-0.38 ms at 5,000 elements and 0.47-0.62 against 1.39-1.44 ms
+at 20,000 (2026-12-03).
+
 ``soft_spheres``: the sphere-sphere forces of the jamming's overlap energy
 (:func:`soft_sphere_forces`), the same operations in the same order as the numpy form in
 :mod:`yade_electro.packing.jamming`, built without floating-point contraction, so that the
@@ -39,7 +45,8 @@ from typing import Optional
 import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
-           "FireSteps", "DeflatedCG", "NativeError"]
+           "FireSteps", "DeflatedCG", "NativeError",
+           "laplacian_fill"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -326,6 +333,36 @@ class FireSteps:
                 self._room = int(1.25 * m)
                 return out[:m]
             room = int(1.25 * m)
+
+
+def laplacian_fill(data, c, e_uu, o1, o2, diag, incidence, extra=None) -> None:
+    """``data`` (K_uu's CSR values) from the edge values ``c``, as
+    :meth:`yade_electro.condensation.ReducedSystem.assemble` fills them with numpy: -c at each
+    unknown-unknown pair's off-diagonal entries ``o1``, ``o2`` (pair t is edge ``e_uu[t]``, or t
+    when ``e_uu`` is None), the incidence matrix (CSR, unknowns x edges, ones) times c on the
+    diagonal entries ``diag`` (int64), plus ``extra``. ``laplacian_fill.cpp``, one pass; raises
+    :class:`NativeError` when it cannot be built."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    width = {np.dtype(np.int32): "32", np.dtype(np.int64): "64"}
+    wi = "i32" if o1.dtype == np.int32 else "i64"
+    if e_uu is not None and e_uu.dtype != o1.dtype:
+        e_uu = e_uu.astype(o1.dtype)
+    symbol = f"laplacian_fill_{wi}_p{width[incidence.indptr.dtype]}_j{width[incidence.indices.dtype]}"
+    if symbol.endswith("p32_j64"):               # (scipy never makes this one)
+        symbol = symbol.replace("p32", "p64")
+        incidence = (incidence.indptr.astype(np.int64), incidence.indices)
+    else:
+        incidence = (incidence.indptr, incidence.indices)
+    f = _shared_function("laplacian_fill", symbol, [i64, ptr, ptr, i64, ptr, ptr, ptr, i64, ptr, ptr, ptr, ptr], None)
+    for a, dt in ((data, np.float64), (c, np.float64), (o1, None), (o2, None), (diag, np.int64)):
+        if not a.flags.c_contiguous or (dt is not None and a.dtype != dt):
+            raise ValueError("laplacian_fill: arrays must be C-contiguous (data, c float64; diag int64)")
+    if extra is not None:
+        extra = np.ascontiguousarray(extra, dtype=np.float64)
+    f(data.size, data.ctypes.data, c.ctypes.data, o1.size, None if e_uu is None else e_uu.ctypes.data,
+      o1.ctypes.data, o2.ctypes.data, diag.size, diag.ctypes.data, incidence[0].ctypes.data,
+      incidence[1].ctypes.data, None if extra is None else extra.ctypes.data)
 
 
 EIGEN_INCLUDE = "/usr/include/eigen3"
