@@ -39,6 +39,48 @@ def test_triangle_distance_against_dense_sampling():
     assert np.max(brute - got) < 5e-3                     # the sampling's resolution
 
 
+def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
+    """The compiled helpers (native/wall_contacts.cpp, the cell grid of fire_steps.cpp) against
+    the numpy / cKDTree forms: triangle distances in every closest-point region (the same to
+    1e-15 relative; exactly on the degenerate cases), the Verlet list and a facet mesh's
+    candidates identical; a sparse box (a sphere far away) goes to the tree."""
+    import yade_electro.contacts as C
+    rng = np.random.default_rng(8)
+    k = 4000
+    tri = rng.uniform(-1, 1, (k, 3, 3))
+    tri[:50, 2] = tri[:50, 1]                                   # degenerate: two equal corners
+    pts = rng.uniform(-2, 2, (k, 3))
+    pts[50:100] = tri[50:100, 0]                                # exactly on a corner
+    fast = C.triangle_distance(pts, tri)
+    slow = C._triangle_distance_numpy(pts, tri)
+    ok = np.isfinite(slow)
+    assert np.all(ok[100:]) and np.allclose(fast[ok], slow[ok], rtol=1e-14, atol=1e-15)
+    assert np.all(fast[50:100] == 0.0)
+    # a drum-like facet mesh and a bed of spheres: the same candidates, tree or compiled
+    ang = np.linspace(0, 2 * np.pi, 25)
+    ring = np.column_stack([np.cos(ang), np.sin(ang)]) * 0.05
+    mesh = []
+    for a, b in zip(ring[:-1], ring[1:]):
+        p0, p1, p2, p3 = [np.array([*xy, z]) for xy, z in ((a, 0), (b, 0), (b, 0.02), (a, 0.02))]
+        mesh += [[p0, p1, p2], [p0, p2, p3]]
+    wall = WallGeometry("triangles", vertices=np.array(mesh))
+    r = np.full(1500, 2e-3)
+    rho = 0.05 * np.sqrt(rng.uniform(0, 1, 1500))
+    phi = rng.uniform(0, 2 * np.pi, 1500)
+    pos = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), rng.uniform(0, 0.02, 1500)])
+    got_w = C.wall_candidates(wall, pos, r, 1e-3)
+    got_p = C.candidate_pairs(pos, r, 1e-3)
+    monkeypatch.setattr(C, "NATIVE", False)
+    ref_w = C.wall_candidates(wall, pos, r, 1e-3)
+    ref_p = C.candidate_pairs(pos, r, 1e-3)
+    assert got_w[0].size > 100 and all(np.array_equal(a, b) for a, b in zip(got_w, ref_w))
+    assert got_p.shape[0] > 1000 and np.array_equal(got_p, ref_p)
+    monkeypatch.setattr(C, "NATIVE", True)
+    far = np.vstack([pos, [[100.0, 0, 0]]])
+    assert C._cell_pairs(far, 5e-3) is None
+    assert np.array_equal(C.candidate_pairs(far, np.append(r, 2e-3), 1e-3), ref_p)
+
+
 def test_plane_box_and_triangle_overlaps():
     r = 1e-3
     pos = np.array([[0, 0, 0.9e-3], [0, 0, -0.5e-3], [0, 0, 2e-3]])

@@ -8,7 +8,8 @@ The list holds every contact until some sphere has moved by more than ``skin / 2
 it was made (two spheres then may have closed the gap by ``skin``): only then is it made
 again. Between two lists a changing contact set is a change of values on a kept structure.
 
-* :func:`candidate_pairs`: the Verlet list (scipy's cKDTree);
+* :func:`candidate_pairs`: the Verlet list (a compiled cell grid; scipy's cKDTree without a
+  compiler);
 * :class:`WallGeometry`: planes (YADE ``Wall``), boxes and triangles (``Facet``), in world
   coordinates;
 * :func:`wall_overlaps`: the overlap delta = r - (distance from the centre to the wall) of
@@ -48,8 +49,11 @@ def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
     radius = np.asarray(radius, dtype=float)
     if pos.shape[0] < 2:
         return np.zeros((0, 2), dtype=np.int64)
-    tree = sphere_tree(pos) if tree is None else tree
-    pairs = tree.query_pairs(2.0 * float(radius.max()) + float(skin), output_type="ndarray").astype(np.int64)
+    cut = 2.0 * float(radius.max()) + float(skin)
+    pairs = _cell_pairs(pos, cut) if tree is None else None
+    if pairs is None:
+        tree = sphere_tree(pos) if tree is None else tree
+        pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64)
     d = np.sqrt(((pos[pairs[:, 0]] - pos[pairs[:, 1]]) ** 2).sum(axis=1))
@@ -57,6 +61,27 @@ def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
     pairs.sort(axis=1)
     order = np.lexsort((pairs[:, 1], pairs[:, 0]))
     return pairs[order]
+
+
+_CELLS = []
+
+
+def _cell_pairs(pos, cut):
+    """Every pair closer than ``cut`` by the compiled cell grid (``FireSteps.pairs_within``),
+    or None (no compiler, a grid too fine for the box, ``NATIVE = False``): then cKDTree."""
+    if not NATIVE:
+        return None
+    span = np.ptp(pos, axis=0) if pos.shape[0] else np.zeros(3)
+    cells = np.prod(np.maximum(1.0, np.floor(span / cut)))
+    if not np.isfinite(cells) or cells > 8 * pos.shape[0] + 4096:
+        return None                      # a sparse box (spheres far apart): the tree is better
+    from .native import FireSteps, NativeError
+    try:
+        if not _CELLS:
+            _CELLS.append(FireSteps(threads=1))
+        return _CELLS[0].pairs_within(np.ascontiguousarray(pos, dtype=np.float64), cut)
+    except NativeError:
+        return None
 
 
 def max_displacement(pos, pos0) -> float:
@@ -148,10 +173,36 @@ class WallGeometry:
         return float(abs((self.point - other.point) @ self.normal))
 
 
+def _native(name):
+    """The compiled helper ``name`` of :mod:`yade_electro.native`, or None (numpy) when it
+    cannot be built or is switched off (``NATIVE = False``, for tests)."""
+    if not NATIVE:
+        return None
+    from . import native
+    return getattr(native, name)
+
+
+#: use the compiled helpers (``native/wall_contacts.cpp``, ``fire_steps.cpp``'s cell grid)
+#: where they build; False: numpy and scipy's cKDTree only
+NATIVE = True
+
+
 def triangle_distance(points, triangles) -> np.ndarray:
     """Distance [m] from each point (k, 3) to the triangle (k, 3, 3) of the same row (the
     closest point of the triangle, faces, edges or corners; Ericson, Real-Time Collision
-    Detection, 5.1.5)."""
+    Detection, 5.1.5). Compiled (:func:`yade_electro.native.triangle_distance`, the same
+    regions and precedence) where it builds, else numpy."""
+    f = _native("triangle_distance")
+    if f is not None:
+        from .native import NativeError
+        try:
+            return f(points, triangles)
+        except NativeError:
+            pass
+    return _triangle_distance_numpy(points, triangles)
+
+
+def _triangle_distance_numpy(points, triangles) -> np.ndarray:
     p = np.asarray(points, float)
     t = np.asarray(triangles, float)
     a, b, c = t[:, 0], t[:, 1], t[:, 2]
@@ -210,8 +261,15 @@ def wall_candidates(wall: WallGeometry, pos, radius, skin: float, tree=None):
         s = np.flatnonzero(d < radius + skin)
         return s, np.zeros(s.size, dtype=np.int64)
     c, rc = wall.reach()
-    tree = sphere_tree(pos) if tree is None else tree
     reach = rc + float(radius.max()) + float(skin)
+    f = _native("triangle_candidates")
+    if f is not None and tree is None:
+        from .native import NativeError
+        try:
+            return f(pos, radius, skin, wall.vertices, c, reach)
+        except NativeError:
+            pass
+    tree = sphere_tree(pos) if tree is None else tree
     lists = tree.query_ball_point(c, reach)
     pieces = np.repeat(np.arange(len(lists)), [len(x) for x in lists])
     spheres = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=pieces.size)

@@ -29,8 +29,7 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from ..contacts import (WallGeometry, candidate_pairs, max_displacement, sphere_tree, wall_candidates,
-                        wall_overlaps)
+from ..contacts import WallGeometry, candidate_pairs, max_displacement, wall_candidates, wall_overlaps
 from ..errors import BoundaryConditionError, GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
@@ -285,11 +284,10 @@ class GranularReader:
                 self.skin = max(self.skin / 1.25, self.SKIN_MIN)
             self._skin_m = self.skin * float(g.radius.min())
         self._built_at = self.calls
-        tree = sphere_tree(pos)
-        edges = candidate_pairs(pos, g.radius, self._skin_m, tree)
+        edges = candidate_pairs(pos, g.radius, self._skin_m)
         self._revision += 1
         self.graph = ContactGraph(pos, g.radius, edges, g.ids, self._revision)
         self._list_pos = self.graph.pos
         self._list_walls = dict(geoms)
-        self._wall_cand = {name: wall_candidates(geoms[name], pos, g.radius, self._skin_m, tree) for name in self.walls}
+        self._wall_cand = {name: wall_candidates(geoms[name], pos, g.radius, self._skin_m) for name in self.walls}
         self.list_builds += 1
