@@ -50,16 +50,16 @@ def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
     if pos.shape[0] < 2:
         return np.zeros((0, 2), dtype=np.int64)
     cut = 2.0 * float(radius.max()) + float(skin)
-    pairs = _cell_pairs(pos, cut) if tree is None else None
+    pairs = _cell_pairs(pos, cut) if tree is None else None     # (i < j already)
     if pairs is None:
         tree = sphere_tree(pos) if tree is None else tree
         pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
+        pairs.sort(axis=1)
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64)
     d = np.sqrt(((pos[pairs[:, 0]] - pos[pairs[:, 1]]) ** 2).sum(axis=1))
     pairs = pairs[d < radius[pairs[:, 0]] + radius[pairs[:, 1]] + skin]
-    pairs.sort(axis=1)
-    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
+    order = np.argsort(pairs[:, 0] * pos.shape[0] + pairs[:, 1], kind="stable")     # lexicographic
     return pairs[order]
 
 
@@ -297,6 +297,9 @@ def wall_overlaps(wall: WallGeometry, pos, radius, spheres, pieces):
     s, dl = spheres[touch], dl[touch]
     if s.size == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
+    if s.size > 1 and np.all(s[1:] >= s[:-1]):       # sorted by sphere (wall_candidates' order)
+        first = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])
+        return s[first], np.maximum.reduceat(dl, first)
     nodes, inv = np.unique(s, return_inverse=True)
     deepest = np.zeros(nodes.size)
     np.maximum.at(deepest, inv, dl)

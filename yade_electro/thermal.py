@@ -843,8 +843,8 @@ class HeatSolver:
         ``h_area``) and the right-hand side sum G_i T_s (fixed nodes take neither)."""
         G, GT = np.zeros(self.n), np.zeros(self.n)
         for name, (nd, g_link) in self._links.items():
-            np.add.at(G, nd, g_link)
-            np.add.at(GT, nd, g_link * self._fixed_value[name])
+            G += np.bincount(nd, g_link, self.n)
+            GT += np.bincount(nd, g_link * self._fixed_value[name], self.n)
         G[self.fixed] = 0.0
         GT[self.fixed] = 0.0
         self._link_G, self._link_GT = G, GT

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
+from operator import attrgetter
 from typing import Dict, List, Optional
 
 import numpy as np
@@ -81,10 +82,11 @@ def _rotations(q):
     """Rotation matrices (k, 3, 3) of unit quaternions (k, 4) stored (x, y, z, w), as YADE's
     ``Quaternion[i]`` gives them."""
     x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], axis=1),
-        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], axis=1),
-        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], axis=1)], axis=1)
+    R = np.empty((q.shape[0], 3, 3))
+    R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
+    R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
+    R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
+    return R
 
 
 class _WallReader:
@@ -100,7 +102,7 @@ class _WallReader:
     def geometry(self, coords=None, slot=None) -> WallGeometry:
         """The wall now; ``coords`` (bodies, 3) [m] from YADE's bulk reader and ``slot`` (the
         row of each existing body id) give the facets' positions without a read per body."""
-        bodies = [self.O.bodies[i] for i in self.ids]
+        bodies = list(map(self.O.bodies.__getitem__, self.ids))
         if self.kind == "Wall":
             b = bodies[0]
             axis, sense = int(b.shape.axis), int(b.shape.sense)
@@ -113,12 +115,12 @@ class _WallReader:
             p, e = b.state.pos, b.shape.extents
             return WallGeometry("box", center=(p[0], p[1], p[2]), axes=_rotation(b.state.ori).T,
                                 extents=(e[0], e[1], e[2]))
-        states = [b.state for b in bodies]
+        states = list(map(attrgetter("state"), bodies))
         if coords is not None:
             pos = coords[[slot[i] for i in self.ids]]
         else:
             pos = np.array([tuple(st.pos) for st in states], dtype=float)
-        quat = np.array([(q[0], q[1], q[2], q[3]) for q in (st.ori for st in states)], dtype=float)
+        quat = np.array([(q[0], q[1], q[2], q[3]) for q in map(attrgetter("ori"), states)], dtype=float)
         R = _rotations(quat)
         verts = pos[:, None, :] + np.einsum("kij,kvj->kvi", R, self._local)
         return WallGeometry("triangles", vertices=verts)
