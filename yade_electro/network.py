@@ -128,10 +128,8 @@ def edge_power(branch_current, conductance) -> np.ndarray:
     """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
     carry no current)."""
     c = np.asarray(conductance, dtype=float)
-    out = np.zeros_like(c)
-    nz = c > 0
-    out[nz] = np.asarray(branch_current, dtype=float)[nz] ** 2 / c[nz]
-    return out
+    w = np.asarray(branch_current, dtype=float)
+    return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
 
 
 @dataclass(frozen=True)
