@@ -43,7 +43,8 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     """The compiled helpers (native/wall_contacts.cpp, the cell grid of fire_steps.cpp) against
     the numpy / cKDTree forms: triangle distances in every closest-point region (the same to
     1e-15 relative; exactly on the degenerate cases), the Verlet list and a facet mesh's
-    candidates identical; a sparse box (a sphere far away) goes to the tree."""
+    candidates identical; the deepest overlaps the same from sorted or shuffled candidates; a
+    sparse box (a sphere far away) goes to the tree."""
     import yade_electro.contacts as C
     rng = np.random.default_rng(8)
     k = 4000
@@ -75,6 +76,13 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     ref_p = C.candidate_pairs(pos, r, 1e-3)
     assert got_w[0].size > 100 and all(np.array_equal(a, b) for a, b in zip(got_w, ref_w))
     assert got_p.shape[0] > 1000 and np.array_equal(got_p, ref_p)
+    # the deepest overlap per sphere: sorted candidates (reduceat) or not (np.unique) alike
+    pos_in = pos * (1 + 2.5e-3 / 0.05)                            # some spheres pressed into the shell
+    touching = C.wall_overlaps(wall, pos_in, r, *ref_w)
+    shuffle = rng.permutation(ref_w[0].size)
+    assert touching[0].size > 10
+    assert all(np.array_equal(a, b) for a, b in zip(touching, C.wall_overlaps(wall, pos_in, r, ref_w[0][shuffle],
+                                                                                 ref_w[1][shuffle])))
     monkeypatch.setattr(C, "NATIVE", True)
     far = np.vstack([pos, [[100.0, 0, 0]]])
     assert C._cell_pairs(far, 5e-3) is None

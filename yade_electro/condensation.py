@@ -159,8 +159,8 @@ class ReducedSystem:
         self._Kdu_from_ud = self._Kdu_pattern.data.astype(np.int64) - 1
         self._Kdu = None
         self._assembled = False
-        self._native = bool(native)     # K_uu filled by the compiled pass (None: not tried yet)
-        self.compiled = None
+        self._native = bool(native)     # K_uu filled by the compiled pass when it builds
+        self.compiled = None            # how the last assembly went (None: numpy asked for, or none yet)
 
     # -- values ------------------------------------------------------------------------------
     def assemble(self, values, diagonal=None):
@@ -193,7 +193,7 @@ class ReducedSystem:
 
     def _fill_compiled(self, c, diagonal) -> bool:
         """K_uu's values by the compiled pass (:func:`yade_electro.native.laplacian_fill`: the
-        numpy form's operations, 5-9x faster at 5,000-20,000 unknowns); False when it is not
+        numpy form's operations, 2-3x faster at 5,000-20,000 unknowns); False when it is not
         asked for or cannot be built (then numpy)."""
         if not self._native:
             return False
