@@ -501,6 +501,7 @@ class DeflatedCGSolver(CGSolver):
             _check_converged(self.name, res, nb, self.rtol, atol, it)
             info = {"solver": self.name, "iterations": it, "residual": res, "setup": fresh,
                     "setup_time": self.setup_time, "iteration_time": time.perf_counter() - t}
+        info["setup"] = fresh                   # (the numpy path's own check finds the setup done)
         info["compiled"] = self._dcg is not None
         info["clusters"] = self._k
         info["cluster_size"] = self.cluster_size_used
