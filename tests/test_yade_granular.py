@@ -141,6 +141,75 @@ def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path
     assert "granular mode only" in out["wall_electrode_bonded"]
 
 
+PERIODIC = r"""
+import json
+from yade import utils
+from yade_electro.yade import ElectricalEngine, HeatEngine
+a, r, n = 0.004, 0.00201, 5
+mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5))
+ids = [O.bodies.append(utils.sphere(((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a), r, material=mat))
+       for i in range(n) for j in range(n) for k in range(n)]
+O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
+             InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                             [Law2_ScGeom_FrictPhys_CundallStrack()]),
+             NewtonIntegrator(gravity=(0, 0, 0), damping=0.3)]
+O.dt = 0.5 * utils.PWaveTimeStep()
+out = {}
+# built on a box, then the cell made periodic: the next call sees it (contacts across the
+# faces would be missing)
+eng = HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="heat", iterPeriod=1)
+O.engines = O.engines + [eng.runner]
+O.run(5, True)
+out["before"] = eng.error is None
+O.periodic = True
+O.cell.setBox(n * a, n * a, n * a)
+try:
+    O.run(5, True)
+    out["switched"] = "accepted"
+except Exception as exc:
+    out["switched"] = f"{type(eng.error).__name__}: {eng.error}"
+O.engines = O.engines[:-1]
+for name, make in {"heat_contacts": lambda: HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="h2"),
+                   "electrical_bonded": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:25], potential=1.0),
+                                                                        "b": dict(select=ids[-25:], potential=0.0)},
+                                                                 label="e2")}.items():
+    try:
+        make()
+        out[name] = "accepted"
+    except Exception as exc:
+        out[name] = f"{type(exc).__name__}: {exc}"
+print(json.dumps(out))
+"""
+
+
+def test_periodic_cells_are_refused(run_yade_script, tmp_path):
+    # the readers take lengths from the positions without the cell's images: refused at the
+    # build, and at the first call after the cell became periodic
+    out = run_yade_script(PERIODIC, timeout=120, cwd=tmp_path, check=True).result
+    assert out["before"]
+    for key in ("switched", "heat_contacts", "electrical_bonded"):
+        assert out[key].startswith("GraphError") and "periodic cell" in out[key], out[key]
+
+
+CLUMPS = r"""
+import json
+from yade import utils
+from yade_electro.yade import HeatEngine
+mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5))
+s = O.bodies.append([utils.sphere((0, 0, 0), 1e-3, material=mat), utils.sphere((1.9e-3, 0, 0), 1e-3, material=mat)])
+O.bodies.appendClumped([utils.sphere((3.8e-3, 0, 0), 1e-3, material=mat),
+                        utils.sphere((5.5e-3, 0, 0), 1e-3, material=mat)])
+e = HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="heat")
+print(json.dumps({"nodes": int(e.reader.graph.n_nodes), "clumps": e.reader.ignored["clump"]}))
+"""
+
+
+def test_clumps_left_out_are_said(run_yade_script, tmp_path):
+    res = run_yade_script(CLUMPS, timeout=120, cwd=tmp_path, check=True)
+    assert res.result == {"nodes": 2, "clumps": 3}          # the clump body and its two members
+    assert "3 clump(s) and clump member(s) are left out" in res.stderr
+
+
 def test_drum_case_small(run_yade_script, tmp_path):
     res = run_yade_script(os.path.join(ROOT, "cases", "rotating_drum.py"), "--n", "200", "--duration", "0.2",
                           "--sample", "0.05", "--baffles", "--out", str(tmp_path), timeout=600, check=True).result

@@ -34,7 +34,7 @@ from ..contacts import WallGeometry, candidate_pairs, max_displacement, wall_can
 from ..errors import BoundaryConditionError, GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
-from .scene import bulk_coordinates, probe_replaced, read_spheres
+from .scene import bulk_coordinates, probe_replaced, read_spheres, warn_left_out
 
 __all__ = ["GranularReader", "WALL_SHAPES", "check_wall_bodies"]
 
@@ -250,14 +250,14 @@ class GranularReader:
     # -- internals -----------------------------------------------------------------------
     def _stamp_now(self):
         U = import_yade().utils
-        return (len(self.O.bodies), float(U.getSpheresVolume()))
+        return (len(self.O.bodies), float(U.getSpheresVolume()), bool(self.O.periodic))
 
     def _changed(self) -> Optional[str]:
         if self.scene_replaced:
             return "scene replaced"
         stamp = self._stamp_now()
         if stamp != self._stamp:
-            names = ("body count", "sphere volume")
+            names = ("body count", "sphere volume", "periodic cell")
             return "changed " + ", ".join(n for n, a, b in zip(names, stamp, self._stamp) if a != b)
         return None
 
@@ -270,6 +270,7 @@ class GranularReader:
         self._bodies = bodies
         self._probe = (int(ids[0]), bodies[0])
         self._stamp = self._stamp_now()
+        warn_left_out(spheres.ignored, self.ignored)
         self.ignored = spheres.ignored
         self.full_reads += 1
         self._skin_m = self.skin * float(rad.min())

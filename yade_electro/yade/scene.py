@@ -4,8 +4,10 @@ written back to the bodies.
 What is read
 ------------
 * nodes: bodies whose shape is a ``Sphere``; clumps and clump members, facets, walls, boxes
-  and every other shape are left out (counted in ``SceneReader.ignored``). An optional
-  ``mask`` keeps only bodies with ``b.mask & mask``.
+  and every other shape are left out (counted in ``SceneReader.ignored``; clumps left out
+  are said in a log warning). An optional ``mask`` keeps only bodies with ``b.mask & mask``.
+  A periodic scene (``O.periodic``) is refused: lengths are taken from the positions,
+  without the cell's images.
 * edges (``bonds='cohesive'``, the continuum mode): real sphere-sphere interactions that
   are cohesive bonds: ``CohFrictPhys`` with ``cohesionBroken == False``, ``JCFpmPhys`` with
   ``isCohesive == True``. With ``bonds='contacts'`` (granular mode) every real
@@ -24,7 +26,8 @@ Every other call compares a *stamp* of YADE's own C++ counters, about 0.6 ms in 
 * the crack counters ``nbTensCracks + nbShearCracks`` of the JCFpm law, when the scene
   uses it (O(1)): every JCFpm bond that breaks;
 * one body compared with the one kept (``O.bodies[i] == b``, a pointer comparison): the
-  scene was replaced (``O.load``, ``O.reset``).
+  scene was replaced (``O.load``, ``O.reset``);
+* ``O.periodic`` (O(1)): the cell made periodic, which the next full read refuses.
 
 A CohFrictMat bond that breaks in shear while its spheres stay pressed together changes no
 counter. ``bond_check`` says how such breaks are found, with a cost of about 0.19 us per
@@ -61,7 +64,7 @@ from ..graph import ContactGraph
 from .runtime import import_yade
 
 __all__ = ["SceneReader", "write_body_attribute", "predicate_selector", "check_write_back", "BOND_CHECKS",
-           "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced"]
+           "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced", "warn_left_out", "PERIODIC_REFUSAL"]
 
 log = logging.getLogger(__name__)
 
@@ -91,10 +94,20 @@ class SphereBodies(NamedTuple):
     ignored: Counter           # what was left out, by reason
 
 
+#: why a periodic scene is refused (the readers take distances from the bodies' positions)
+PERIODIC_REFUSAL = (
+    "the scene has a periodic cell (O.periodic is True), which yade-electro does not support: it takes bond and "
+    "contact lengths from the bodies' positions without the cell's periodic images, so the bonds and contacts "
+    "that cross the cell's faces would be missing or given the wrong length. Run the packing in a box without "
+    "periodicity (walls or facets around it), or cut a piece out of the periodic packing")
+
+
 def read_spheres(O, mask: Optional[int] = None) -> SphereBodies:
     """Every body whose shape is a ``Sphere`` (not a clump or clump member, and with ``b.mask &
     mask`` when a mask is given), by a Python loop over ``O.bodies``. GraphError when there is
-    none, or a radius is not finite and > 0."""
+    none, a radius is not finite and > 0, or the scene is periodic (:data:`PERIODIC_REFUSAL`)."""
+    if O.periodic:
+        raise GraphError(PERIODIC_REFUSAL)
     Sphere = import_yade().Sphere
     ids, pos, rad, bodies, existing = [], [], [], [], []
     ignored = Counter()
@@ -129,6 +142,17 @@ def read_spheres(O, mask: Optional[int] = None) -> SphereBodies:
     slot = {bid: k for k, bid in enumerate(existing)}
     return SphereBodies(ids, np.asarray(pos, dtype=float), rad, bodies, slot,
                         np.array([slot[int(i)] for i in ids], dtype=np.int64), ignored)
+
+
+def warn_left_out(ignored: Counter, before: Counter) -> None:
+    """Say (a log warning) when a full read leaves out more clumps than the one before: a
+    clump's members do not conduct, nor do the contacts they make (only plain spheres are
+    elements), which a bed of clumps would otherwise get silently."""
+    n = ignored.get("clump", 0)
+    if n > before.get("clump", 0):
+        log.warning("%d clump(s) and clump member(s) are left out: clumps are not elements (only plain spheres "
+                    "are), so they carry no heat or current and their contacts do not conduct. Use spheres, or "
+                    "leave the clumps out of the mask on purpose", n)
 
 
 def bulk_coordinates(n_existing: int) -> np.ndarray:
@@ -274,7 +298,7 @@ class SceneReader:
         U = import_yade().utils
         cracks = sum(int(f.nbTensCracks) + int(f.nbShearCracks) for f in self._jcfpm)
         real = self.O.interactions.countReal() if count_real else self._stamp[1]
-        return (len(self.O.bodies), real, float(U.getSpheresVolume()), cracks)
+        return (len(self.O.bodies), real, float(U.getSpheresVolume()), cracks, bool(self.O.periodic))
 
     def _changed(self) -> Optional[str]:
         if self.scene_replaced:
@@ -285,7 +309,7 @@ class SceneReader:
         sweeping = self.bond_mode == "sweep" and self.bonds == "cohesive" and self._phys
         stamp = self._stamp_now(count_real=not sweeping or self._sweep_at == 0)
         if stamp != self._stamp:
-            names = ("body count", "real interactions", "sphere volume", "crack counters")
+            names = ("body count", "real interactions", "sphere volume", "crack counters", "periodic cell")
             return "changed " + ", ".join(n for n, a, b in zip(names, stamp, self._stamp) if a != b)
         mode = self.bond_mode
         if mode in ("count", "counters") or not self._phys:
@@ -349,6 +373,7 @@ class SceneReader:
         self._probe = (int(ids[0]), bodies[0])
         self._jcfpm = _jcfpm_laws(O)
         self._stamp = self._stamp_now()
+        warn_left_out(spheres.ignored, self.ignored)
         self.ignored = spheres.ignored
         self.full_reads += 1
         if self.bonds == "cohesive" and not edges:
