@@ -193,3 +193,64 @@ def test_feng_pipe_law():
     assert make_law("pipe", width=w).factor(apart)[0] == 0.0
     with pytest.raises(ValueError, match="needs width="):
         make_law("pipe")
+
+
+def _periodic_brute_force(pos, radius, skin, H):
+    """Every (i < j, image) within r_i + r_j + skin, over the images around the nearest one."""
+    import itertools
+    s = pos @ np.linalg.inv(H).T
+    ds = s[None, :, :] - s[:, None, :]
+    base = -np.round(ds)
+    out = set()
+    for k in itertools.product((-1, 0, 1), repeat=3):
+        c = base + np.array(k)
+        d = (ds + c) @ H.T
+        close = np.triu(np.sqrt((d ** 2).sum(-1)) < radius[:, None] + radius[None, :] + skin, 1)
+        for a, b in zip(*np.nonzero(close)):
+            out.add((int(a), int(b), *c[a, b].astype(int).tolist()))
+    return out
+
+
+@pytest.mark.parametrize("sheared", [False, True])
+def test_periodic_candidate_pairs_are_every_close_image(sheared):
+    # centres anywhere (YADE does not wrap them): up to 3 cells away from the reference one
+    from yade_electro.contacts import periodic_candidate_pairs
+    rng = np.random.default_rng(7 + sheared)
+    H = np.diag([0.02, 0.015, 0.018])
+    if sheared:
+        H = H + np.array([[0, 0.004, 0.001], [0, 0, 0.002], [0, 0, 0]])
+    n = 300
+    pos = (rng.random((n, 3)) + rng.integers(-3, 4, size=(n, 3))) @ H.T
+    radius = rng.uniform(0.0008, 0.0012, n)
+    pairs, images = periodic_candidate_pairs(pos, radius, 3e-4, H)
+    got = {(int(a), int(b), *c.tolist()) for (a, b), c in zip(pairs, images)}
+    assert len(got) == len(pairs) > 300 and got == _periodic_brute_force(pos, radius, 3e-4, H)
+    key = pairs[:, 0] * n + pairs[:, 1]
+    assert np.all(np.diff(key) > 0)                          # lexicographic, one image per pair
+    d = pos[pairs[:, 1]] - pos[pairs[:, 0]] + images @ H.T   # the image is the contact's
+    assert np.all(np.linalg.norm(d, axis=1) < radius[pairs[:, 0]] + radius[pairs[:, 1]] + 3e-4)
+
+
+def test_periodic_cell_too_small_is_refused():
+    from yade_electro.contacts import periodic_candidate_pairs
+    from yade_electro.errors import GraphError
+    pos = np.array([[0.001, 0.001, 0.001], [0.003, 0.001, 0.001]])
+    with pytest.raises(GraphError, match="periodic cell is too small"):
+        periodic_candidate_pairs(pos, np.full(2, 1e-3), 1e-4, np.eye(3) * 0.004)
+    with pytest.raises(GraphError, match="independent base vectors"):
+        periodic_candidate_pairs(pos, np.full(2, 1e-3), 1e-4, np.zeros((3, 3)))
+
+
+def test_periodic_graph_lengths_and_contact_factors():
+    # two spheres touching through the cell's face: the shift gives their contact
+    from yade_electro.contacts import periodic_candidate_pairs
+    H = np.eye(3) * 0.02
+    pos = np.array([[0.0005, 0.01, 0.01], [0.0195 + 0.04, 0.01, 0.01]])    # the second two periods away
+    radius = np.array([1e-3, 1e-3])
+    pairs, images = periodic_candidate_pairs(pos, radius, 1e-4, H)
+    assert pairs.tolist() == [[0, 1]] and images.tolist() == [[-3, 0, 0]]
+    g = ContactGraph(pos, radius, pairs, shift=images @ H.T)
+    assert g.length == pytest.approx([1e-3], rel=1e-12)
+    law = make_law("contact")
+    a = math.sqrt(1e-3 ** 2 - 0.5e-3 ** 2)                   # lens of the 1 mm overlap
+    assert law.factor(g) == pytest.approx([2 * a], rel=1e-12)

@@ -138,3 +138,30 @@ def test_graph_error_is_a_value_error():
     # callers that only know ValueError still catch it
     with pytest.raises(ValueError):
         ContactGraph(np.zeros((1, 3)), [-1.0], [])
+
+
+def test_periodic_shift_follows_the_edges():
+    # a chain 0-1-2 whose bond (2, 0) closes through the cell's face (period 3 along x)
+    pos = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.0, 0, 0]])
+    edges = [[0, 1], [1, 2], [2, 0]]
+    shift = [[0, 0, 0], [0, 0, 0], [3.0, 0, 0]]          # node 0's image next to node 2
+    g = ContactGraph(pos, np.full(3, 0.6), edges, shift=shift)
+    assert g.edges.tolist() == [[0, 1], [1, 2], [0, 2]]
+    assert g.shift.tolist() == [[0, 0, 0], [0, 0, 0], [-3.0, 0, 0]]     # negated with the swap
+    assert g.length.tolist() == [1.0, 1.0, 1.0]
+    assert g.edge_vectors([[2, 0], [1, 2]]).tolist() == [[1.0, 0, 0], [1.0, 0, 0]]
+    assert np.allclose(g.neighbour_barycentre(), pos)    # each node between its two neighbours
+    moved = g.with_positions(pos + 0.5)                  # the shifts kept
+    assert moved.length.tolist() == [1.0, 1.0, 1.0] and moved.shift is g.shift
+    stretched = g.with_positions(pos * 1.1, shift=np.array(g.shift) * 1.1)
+    assert np.allclose(stretched.length, 1.1)
+    sub = g.subgraph([False, True, True])
+    assert sub.edges.tolist() == [[1, 2], [0, 2]] and sub.length.tolist() == [1.0, 1.0]
+    with pytest.raises(GraphError, match="shift="):
+        g.with_edges([[0, 1]])
+    with pytest.raises(GraphError, match="not edges of this periodic graph"):
+        g.edge_vectors([[0, 0]])
+    with pytest.raises(GraphError, match="shift must be a finite"):
+        ContactGraph(pos, np.full(3, 0.6), edges, shift=[[0, 0, 0]])
+    with pytest.raises(GraphError, match="no periodic shifts"):
+        ContactGraph(pos, np.full(3, 0.6), edges).with_positions(pos, shift=np.zeros((3, 3)))

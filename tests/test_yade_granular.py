@@ -142,37 +142,68 @@ def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path
 
 
 PERIODIC = r"""
-import json
+import json, math
+import numpy as np
 from yade import utils
 from yade_electro.yade import ElectricalEngine, HeatEngine
-a, r, n = 0.004, 0.00201, 5
-mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5))
+n, a, r = 6, 0.004, 0.00201               # a simple-cubic bed, 0.02 mm overlaps, 3 n^3 contacts
+L = n * a
+mat = O.materials.append(FrictMat(young=1.0, poisson=0.3, density=7850, frictionAngle=0.5))
 ids = [O.bodies.append(utils.sphere(((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a), r, material=mat))
        for i in range(n) for j in range(n) for k in range(n)]
-O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
-             InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
-                             [Law2_ScGeom_FrictPhys_CundallStrack()]),
-             NewtonIntegrator(gravity=(0, 0, 0), damping=0.3)]
-O.dt = 0.5 * utils.PWaveTimeStep()
+x0 = np.array([O.bodies[i].state.pos[0] for i in ids])
 out = {}
-# built on a box, then the cell made periodic: the next call sees it (contacts across the
-# faces would be missing)
-eng = HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="heat", iterPeriod=1)
+# built on a box, then the cell made periodic: the engine's next call takes the images
+O.engines = [ForceResetter(), NewtonIntegrator(gravity=(0, 0, 0))]
+O.dt = 1e-4
+T0, dT = 300.0, 10.0
+mode = np.cos(2 * math.pi * x0 / L)
+init = {int(i): T0 + dT * c for i, c in zip(ids, mode)}
+eng = HeatEngine(7850, 470, 50, T0, initial_temperature=init, bonds="contacts", law="contact",
+                 theta="backward-euler", iterPeriod=1, time_scale=100.0, label="heat")
 O.engines = O.engines + [eng.runner]
-O.run(5, True)
-out["before"] = eng.error is None
+O.run(1, True)
+out["box_contacts"] = int(np.sum(eng.contact_heat_flow()[1] > 0))
 O.periodic = True
-O.cell.setBox(n * a, n * a, n * a)
-try:
-    O.run(5, True)
-    out["switched"] = "accepted"
-except Exception as exc:
-    out["switched"] = f"{type(eng.error).__name__}: {eng.error}"
-O.engines = O.engines[:-1]
-for name, make in {"heat_contacts": lambda: HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="h2"),
-                   "electrical_bonded": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:25], potential=1.0),
-                                                                        "b": dict(select=ids[-25:], potential=0.0)},
-                                                                 label="e2")}.items():
+O.cell.setBox(L, L, L)
+for i in ids:
+    O.bodies[i].state.vel = (0.3, 0.2, 0.1)     # the bed drifts through the cell's faces
+t_start = eng.coupled.time
+A_start = 2.0 / len(ids) * np.sum((eng.temperature - T0) * mode)
+O.run(200, True)
+T = np.array([eng.temperature_by_id[int(i)] for i in ids])
+A = 2.0 / len(ids) * np.sum((T - T0) * mode)
+m = 7850 * 4 / 3 * math.pi * r ** 3 * 470
+G = 2 * 50 * math.sqrt(r ** 2 - (a / 2) ** 2)             # H = 2 k a, the lens of the overlap
+lam = 2 * G / m * (1 - math.cos(2 * math.pi / n))        # the mode's rate on the periodic lattice
+h = O.dt * 100
+steps = round((eng.coupled.time - t_start) / h)
+out.update(A_rel=A / (A_start * (1 + lam * h) ** -steps) - 1, mode_dev=float(np.max(np.abs(T - T0 - A * mode))),
+           steps=steps, contacts=int(np.sum(eng.contact_heat_flow()[1] > 0)), crossed=float(max(
+               O.bodies[i].state.pos[0] for i in ids)) > L)
+# a deforming, shearing cell: the contacts against the nearest images of YADE's own cell
+O.cell.velGrad = Matrix3(0.5, 0, 0, 0, 0, 0, 0.2, 0, 0)
+agree = []
+for k in range(20):
+    O.run(10, True)
+    Hm = np.array([[O.cell.hSize[p, q] for q in range(3)] for p in range(3)])
+    S = np.array([O.cell.wrap(O.bodies[i].state.pos) for i in ids]) @ np.linalg.inv(Hm).T
+    dS = S[None] - S[:, None]
+    dS -= np.round(dS)
+    brute = int(np.sum(np.triu(np.linalg.norm(dS @ Hm.T, axis=2) < 2 * r, 1)))
+    agree.append((int(np.sum(eng.contact_heat_flow()[1] > 0)), brute))
+out["deforming"] = agree
+O.engines = O.engines[:2]
+for name, make in {
+        "electrical_bonded": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:36], potential=1.0),
+                                                             "b": dict(select=ids[-36:], potential=0.0)}, label="e1"),
+        "electrical_contacts": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:36], potential=1.0),
+                                                               "b": dict(select=ids[-36:], potential=0.0)},
+                                                        bonds="contacts", law="contact", label="e2"),
+        "heat_bonded": lambda: HeatEngine(7850, 470, 50, T0, label="h1"),
+        "heat_walls": lambda: HeatEngine(7850, 470, 50, T0, bonds="contacts", label="h2",
+                                         walls={"w": dict(bodies=[O.bodies.append(utils.wall(0, axis=2))],
+                                                          temperature=T0)})}.items():
     try:
         make()
         out[name] = "accepted"
@@ -182,13 +213,19 @@ print(json.dumps(out))
 """
 
 
-def test_periodic_cells_are_refused(run_yade_script, tmp_path):
-    # the readers take lengths from the positions without the cell's images: refused at the
-    # build, and at the first call after the cell became periodic
-    out = run_yade_script(PERIODIC, timeout=120, cwd=tmp_path, check=True).result
-    assert out["before"]
-    for key in ("switched", "heat_contacts", "electrical_bonded"):
+def test_periodic_cells_conduct_across_their_faces(run_yade_script, tmp_path):
+    # heat in a periodic simple-cubic bed drifting through the cell's faces: a cosine mode
+    # decays by the exact backward-Euler factor of the lattice's rate (every contact, through
+    # every face); in a stretching, shearing cell the contacts are those of the nearest images
+    out = run_yade_script(PERIODIC, timeout=300, cwd=tmp_path, check=True).result
+    assert out["box_contacts"] == 540 and out["contacts"] == 648 and out["crossed"]     # 3 n^2 (n - 1), 3 n^3
+    assert out["steps"] == 200 and abs(out["A_rel"]) < 1e-9 and out["mode_dev"] < 1e-9
+    counts = [c for c, _ in out["deforming"]]
+    assert all(c == b for c, b in out["deforming"]) and counts[0] == 648 and counts[-1] == 432
+    # refused: the bonded reader, electrodes and walls in a periodic cell
+    for key in ("electrical_bonded", "electrical_contacts", "heat_bonded"):
         assert out[key].startswith("GraphError") and "periodic cell" in out[key], out[key]
+    assert out["heat_walls"].startswith("GraphError") and "walls (['w']) in a periodic cell" in out["heat_walls"]
 
 
 CLUMPS = r"""

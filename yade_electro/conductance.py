@@ -123,7 +123,7 @@ def make_law(law="continuum", **params) -> "ConductanceLaw":
 def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
     """Centre-to-centre distance of node pairs [m]; MaterialError for coincident centres."""
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    d = graph.pos[edges[:, 1]] - graph.pos[edges[:, 0]]
+    d = graph.edge_vectors(edges)
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     if np.any(length <= 0):
         raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
@@ -438,7 +438,7 @@ class FactorNetwork:
         self.factor = None
         self._net = None
         self._slots = None
-        self._pos = None
+        self._pos = self._shift = None
 
     def update(self, graph: ContactGraph):
         from .network import edge_slots
@@ -450,7 +450,9 @@ class FactorNetwork:
             self._rebuild(graph)
             return "structure"
         same_bonds = graph.edges is old.edges or np.array_equal(graph.edges, old.edges)
-        moved = not (graph.pos is self._pos or np.array_equal(graph.pos, self._pos))
+        moved = not (graph.pos is self._pos or np.array_equal(graph.pos, self._pos)) or not (
+            graph.shift is self._shift or (graph.shift is not None and self._shift is not None
+                                           and np.array_equal(graph.shift, self._shift)))
         if same_bonds and not moved:
             return None
         kind = "geometry"
@@ -464,14 +466,14 @@ class FactorNetwork:
             kind = "topology"
         g = np.zeros(self.edges.shape[0])
         g[self._slots] = self.law.factor(graph, self._net)
-        self.factor, self._pos = g, graph.pos
+        self.factor, self._pos, self._shift = g, graph.pos, graph.shift
         return kind
 
     def _rebuild(self, graph):
         net = self.law.network(graph)
         self.edges, self._net, self._slots = net, net, np.arange(net.shape[0])
         self.factor = self.law.factor(graph, net)
-        self._pos = graph.pos
+        self._pos, self._shift = graph.pos, graph.shift
 
 
 __all__ += ["FactorNetwork"]

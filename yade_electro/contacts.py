@@ -9,7 +9,7 @@ it was made (two spheres then may have closed the gap by ``skin``): only then is
 again. Between two lists a changing contact set is a change of values on a kept structure.
 
 * :func:`candidate_pairs`: the Verlet list (a compiled cell grid; scipy's cKDTree without a
-  compiler);
+  compiler); :func:`periodic_candidate_pairs` in a periodic cell, with each pair's image;
 * :class:`WallGeometry`: planes (YADE ``Wall``), boxes and triangles (``Facet``), in world
   coordinates;
 * :func:`wall_overlaps`: the overlap delta = r - (distance from the centre to the wall) of
@@ -26,8 +26,9 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["sphere_tree", "candidate_pairs", "new_wall_contacts", "max_displacement", "WallGeometry",
-           "wall_candidates", "wall_overlaps", "plane_contact_radius", "triangle_distance"]
+__all__ = ["sphere_tree", "candidate_pairs", "periodic_candidate_pairs", "cell_widths", "new_wall_contacts",
+           "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps", "plane_contact_radius",
+           "triangle_distance"]
 
 
 def _ro(a):
@@ -61,6 +62,86 @@ def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
     pairs = pairs[d < radius[pairs[:, 0]] + radius[pairs[:, 1]] + skin]
     order = np.argsort(pairs[:, 0] * pos.shape[0] + pairs[:, 1], kind="stable")     # lexicographic
     return pairs[order]
+
+
+def cell_widths(cell) -> np.ndarray:
+    """Distances [m] between the opposite faces of a periodic cell whose base vectors [m] are
+    the columns of ``cell`` (3, 3) (YADE's ``O.cell.hSize``)."""
+    H = np.asarray(cell, dtype=float).reshape(3, 3)
+    a, b, c = H[:, 0], H[:, 1], H[:, 2]
+    vol = abs(float(np.linalg.det(H)))
+    areas = np.array([np.linalg.norm(np.cross(b, c)), np.linalg.norm(np.cross(c, a)), np.linalg.norm(np.cross(a, b))])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(areas > 0, vol / areas, 0.0)
+
+
+def periodic_candidate_pairs(pos, radius, skin: float, cell):
+    """The Verlet list of spheres in a periodic cell (base vectors [m] the columns of
+    ``cell``, YADE's ``O.cell.hSize``, sheared or not): every pair (i < j) some image of
+    which is closer than ``r_i + r_j + skin`` [m]. ``pos`` are the spheres' centres [m]
+    anywhere (YADE does not wrap them into the cell).
+
+    Returns ``(pairs, images)``: ``pairs`` (m, 2) in lexicographic order, and ``images``
+    (m, 3) int64, the cell periods c such that the separation of the pair's contact is
+    ``x_j - x_i + cell @ c`` for these positions. The centres are wrapped into the cell, the
+    spheres within the search distance of a face are copied to the neighbouring images (the
+    26 of them), and the pairs are found among the copies as in :func:`candidate_pairs`. A
+    cell narrower than twice the search distance 2 r_max + skin (where a pair could touch
+    through two images) raises GraphError."""
+    import itertools
+    from .errors import GraphError
+    pos = np.asarray(pos, dtype=float)
+    radius = np.asarray(radius, dtype=float)
+    H = np.asarray(cell, dtype=float).reshape(3, 3)
+    n = pos.shape[0]
+    empty = (np.zeros((0, 2), dtype=np.int64), np.zeros((0, 3), dtype=np.int64))
+    if not np.all(np.isfinite(H)) or abs(float(np.linalg.det(H))) <= 0:
+        raise GraphError(f"the periodic cell must have finite, independent base vectors, got {H.tolist()}")
+    if n == 0:
+        return empty
+    cut = 2.0 * float(radius.max()) + float(skin)
+    widths = cell_widths(H)
+    if cut >= 0.5 * widths.min():
+        raise GraphError(f"the periodic cell is too small for these spheres: its narrowest width is "
+                         f"{widths.min():.6g} m, and a contact search of 2 r_max + skin = {cut:.6g} m must be below "
+                         "half of it (a pair could then touch through two images). Make the cell larger")
+    s = pos @ np.linalg.inv(H).T                      # reduced coordinates
+    periods = np.floor(s)
+    w = s - periods                                   # wrapped into [0, 1)
+    margin = cut / widths
+    idx, img = [np.arange(n)], [np.zeros((n, 3), dtype=np.int64)]
+    for k in itertools.product((-1, 0, 1), repeat=3):
+        if k == (0, 0, 0):
+            continue
+        wk = w + np.array(k)
+        sel = np.flatnonzero(np.all((wk > -margin) & (wk < 1.0 + margin), axis=1))
+        idx.append(sel)
+        img.append(np.tile(np.array(k, dtype=np.int64), (sel.size, 1)))
+    idx, img = np.concatenate(idx), np.concatenate(img)
+    X = (w[idx] + img) @ H.T
+    found = _cell_pairs(X, cut)
+    if found is None:
+        found = sphere_tree(X).query_pairs(cut, output_type="ndarray").astype(np.int64)
+    if found.size == 0:
+        return empty
+    a, b = found[:, 0], found[:, 1]
+    real = ~np.any(img[a] != 0, axis=1) | ~np.any(img[b] != 0, axis=1)      # one of the two in the cell
+    a, b = a[real], b[real]
+    i, j, k = idx[a], idx[b], img[b] - img[a]
+    swap = i > j
+    i, j = np.where(swap, j, i), np.where(swap, i, j)
+    k = np.where(swap[:, None], -k, k)
+    keep = i != j
+    rows = np.unique(np.column_stack([i[keep], j[keep], k[keep]]), axis=0)
+    if rows.size == 0:
+        return empty
+    pairs = rows[:, :2]
+    images = rows[:, 2:] - periods[pairs[:, 1]].astype(np.int64) + periods[pairs[:, 0]].astype(np.int64)
+    d = pos[pairs[:, 1]] - pos[pairs[:, 0]] + images @ H.T
+    near = np.sqrt(np.einsum("ij,ij->i", d, d)) < radius[pairs[:, 0]] + radius[pairs[:, 1]] + skin
+    pairs, images = pairs[near], images[near]
+    order = np.argsort(pairs[:, 0] * n + pairs[:, 1], kind="stable")     # lexicographic
+    return pairs[order], images[order]
 
 
 _CELLS = []

@@ -43,6 +43,11 @@ class ContactGraph:
     revision : int
         A counter the producer bumps when the graph changes; consumers use it, with
         ``key``, to reuse work done on an unchanged graph.
+    shift : (m, 3) float array, optional
+        In a periodic cell, the vector [m] added to ``pos[j] - pos[i]`` to get the
+        separation of the bond (i, j) (the periodic image of j next to i); None: no images.
+        It follows the edges: an edge given as (j, i) is stored as (i, j) with its shift
+        negated.
     """
 
     pos: np.ndarray
@@ -50,6 +55,7 @@ class ContactGraph:
     edges: np.ndarray
     ids: np.ndarray = None  # type: ignore[assignment]
     revision: int = 0
+    shift: np.ndarray = None  # type: ignore[assignment]
     _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def __post_init__(self):
@@ -79,6 +85,12 @@ class ContactGraph:
             raise GraphError(f"edge node index out of range 0..{n - 1}")
         if np.any(edges[:, 0] == edges[:, 1]):
             raise GraphError("edges contain self loops (a node bonded to itself)")
+        shift = None
+        if self.shift is not None:
+            shift = np.array(self.shift, dtype=float).reshape(-1, 3) if np.size(self.shift) else np.zeros((0, 3))
+            if shift.shape != (edges.shape[0], 3) or not np.all(np.isfinite(shift)):
+                raise GraphError(f"shift must be a finite ({edges.shape[0]}, 3) array (m), one vector per edge")
+            shift[edges[:, 0] > edges[:, 1]] *= -1.0
         edges = np.sort(edges, axis=1)
         key = edges[:, 0] * n + edges[:, 1]
         if np.unique(key).size != key.size:
@@ -92,6 +104,7 @@ class ContactGraph:
         object.__setattr__(self, "radius", _readonly(radius))
         object.__setattr__(self, "edges", _readonly(edges))
         object.__setattr__(self, "ids", _readonly(ids))
+        object.__setattr__(self, "shift", None if shift is None else _readonly(shift))
 
     # -- sizes ---------------------------------------------------------------------------
     @property
@@ -116,7 +129,7 @@ class ContactGraph:
     def length(self) -> np.ndarray:
         """Centre-to-centre distance l_ij of each edge [m]."""
         def make():
-            d = self.pos[self.edges[:, 1]] - self.pos[self.edges[:, 0]]
+            d = self.edge_vectors()
             return np.sqrt(np.einsum("ij,ij->i", d, d))
         return self._cached("length", make)
 
@@ -168,7 +181,8 @@ class ContactGraph:
         def make():
             n = self.n_nodes
             i, j = self.edges[:, 0], self.edges[:, 1]
-            s = np.stack([np.bincount(i, self.pos[j, k], n) + np.bincount(j, self.pos[i, k], n)
+            d = self.edge_vectors()             # the neighbour's image next to the node
+            s = np.stack([np.bincount(i, self.pos[i, k] + d[:, k], n) + np.bincount(j, self.pos[j, k] - d[:, k], n)
                           for k in range(3)], axis=1)
             deg = self.degree
             out = self.pos.copy()
@@ -177,29 +191,64 @@ class ContactGraph:
             return out
         return self._cached("barycentre", make)
 
-    def with_positions(self, pos, revision=None) -> "ContactGraph":
+    def edge_vectors(self, edges=None) -> np.ndarray:
+        """Separation x_j - x_i [m] of each edge (i, j) (``edges``: node pairs of this graph,
+        default all), with the periodic image's shift when the graph has one."""
+        e = self.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        d = self.pos[e[:, 1]] - self.pos[e[:, 0]]
+        if self.shift is None:
+            return d
+        if e is self.edges or (e.shape == self.edges.shape and np.array_equal(e, self.edges)):
+            return d + self.shift
+        key = self.edges[:, 0] * self.n_nodes + self.edges[:, 1]
+        order = np.argsort(key)
+        lo, hi = np.minimum(e[:, 0], e[:, 1]), np.maximum(e[:, 0], e[:, 1])
+        want = lo * self.n_nodes + hi
+        at = np.clip(np.searchsorted(key[order], want), 0, key.size - 1) if key.size else np.zeros(0, np.int64)
+        if not key.size or not np.array_equal(key[order][at], want):
+            raise GraphError("edge_vectors: some node pairs are not edges of this periodic graph (their image is "
+                             "unknown)")
+        sign = np.where(e[:, 0] < e[:, 1], 1.0, -1.0)[:, None]
+        return d + sign * self.shift[order][at]
+
+    def with_positions(self, pos, revision=None, shift=None) -> "ContactGraph":
         """A new graph of the same elements and bonds at other positions [m] (the elements
-        moved). The bonds and ids, validated already, are shared, not checked again."""
+        moved); ``shift``: the edges' new periodic shifts (default: the kept ones). The
+        bonds and ids, validated already, are shared, not checked again."""
         pos = np.asarray(pos, dtype=float)
         if pos.shape != self.pos.shape:
             raise GraphError(f"pos must have shape {self.pos.shape}, got {pos.shape}")
         if not np.all(np.isfinite(pos)):
             bad = np.flatnonzero(~np.all(np.isfinite(pos), axis=1))
             raise GraphError(f"non-finite positions at nodes {bad[:10].tolist()}")
+        if shift is None:
+            shift = self.shift
+        else:
+            if self.shift is None:
+                raise GraphError("with_positions: this graph has no periodic shifts to replace")
+            shift = np.asarray(shift, dtype=float)
+            if shift.shape != self.shift.shape or not np.all(np.isfinite(shift)):
+                raise GraphError(f"shift must be a finite {self.shift.shape} array (m)")
+            shift = _readonly(shift)
         g = object.__new__(ContactGraph)
         for name, value in (("pos", _readonly(pos)), ("radius", self.radius), ("edges", self.edges),
                             ("ids", self.ids), ("revision", self.revision + 1 if revision is None else revision),
+                            ("shift", shift),
                             ("_cache", {k: v for k, v in self._cache.items() if k in ("degree", "volume",
                                                                                      "incidence", "components",
                                                                                      "id_order")})):
             object.__setattr__(g, name, value)
         return g
 
-    def with_edges(self, edges, revision=None) -> "ContactGraph":
-        """A new graph with the same elements and other bonds (e.g. after bonds broke)."""
+    def with_edges(self, edges, revision=None, shift=None) -> "ContactGraph":
+        """A new graph with the same elements and other bonds (e.g. after bonds broke);
+        ``shift``: their periodic shifts, required when this graph has some."""
+        if self.shift is not None and shift is None:
+            raise GraphError("with_edges: this graph is periodic; give the new edges' shift= too")
         return ContactGraph(self.pos, self.radius, edges, self.ids,
-                            self.revision + 1 if revision is None else revision)
+                            self.revision + 1 if revision is None else revision, shift)
 
     def subgraph(self, keep_edges) -> "ContactGraph":
         """A new graph with the same elements and only the edges where ``keep_edges`` is true."""
-        return self.with_edges(self.edges[np.asarray(keep_edges, dtype=bool)])
+        keep = np.asarray(keep_edges, dtype=bool)
+        return self.with_edges(self.edges[keep], shift=None if self.shift is None else self.shift[keep])

@@ -79,6 +79,8 @@ class _Engine:
     """What both engines share: configuration, scene reader, runner, history, state tags."""
 
     DEFAULT_LABEL = "electro"
+    #: heat conduction only (no electrodes): periodic cells are taken in the granular mode
+    _heat_only = False
 
     def _start(self, O, label, resume, iterPeriod, reader_options, history, history_mode, write_back, plot):
         yade = import_yade()
@@ -91,7 +93,8 @@ class _Engine:
         opts = dict(reader_options)
         skin, walls = opts.pop("skin", "auto"), opts.pop("walls", None)
         if opts["bonds"] == "contacts":
-            self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls)
+            self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls,
+                                         periodic=self._heat_only)
         else:
             if self._declared_walls:
                 raise BoundaryConditionError("walls (walls=, or electrodes with wall=) conduct in the granular mode "
@@ -575,6 +578,7 @@ class ElectroThermalEngine(ElectricalEngine):
         self._walls = {w.name: dict(bodies=list(ids), temperature=w.temperature, conductivity=w.conductivity)
                        for w, ids in wall_specs}
         self._declared_walls = list(self._electrode_walls) + list(self._walls)     # adiabatic ones too
+        self._heat_only = electrodes is None
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
                     write_back if electrodes is not None else None, plot)
         for w, ids in wall_specs:

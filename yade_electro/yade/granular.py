@@ -17,8 +17,19 @@ Walls: ``walls={name: dict(bodies=ids, ...)}`` names YADE bodies whose shape is 
 geometry is read at every call (a few Python reads per body) and the spheres touching them
 are found with the same skin (:mod:`yade_electro.contacts`).
 
+Periodic cells (``O.periodic``, sheared or not, and deforming through ``O.cell.velGrad``):
+the Verlet list is made with the cell's images
+(:func:`yade_electro.contacts.periodic_candidate_pairs`); the graph's positions are the
+centres wrapped into the cell (what the selections, the outputs and VTK see) and each edge
+carries the shift of its image (``ContactGraph.shift``), recomputed at every call from the
+cell and the spheres' own periods, so a sphere leaving the cell through a face keeps its
+contacts. The list is made again when the spheres' moves in the cell's frame and the cell's
+deformation since the list could have closed a gap of a skin. Walls and electrodes are
+refused in a periodic cell.
+
 Full reads (a Python loop over the bodies) happen when the body count or the total sphere
-volume changes (spheres added, erased, or a radius changed) or the scene was replaced.
+volume changes (spheres added, erased, or a radius changed), the cell becomes periodic or
+not, or the scene was replaced.
 Units: SI.
 """
 from __future__ import annotations
@@ -30,7 +41,8 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from ..contacts import WallGeometry, candidate_pairs, max_displacement, wall_candidates, wall_overlaps
+from ..contacts import (WallGeometry, candidate_pairs, max_displacement, periodic_candidate_pairs, wall_candidates,
+                        wall_overlaps)
 from ..errors import BoundaryConditionError, GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
@@ -146,10 +158,16 @@ class GranularReader:
         price of more candidate pairs.
     walls : dict name -> body id or list of ids, optional
         The walls whose contacts are wanted (see module doc).
+    periodic : bool
+        Take periodic cells (default False: a periodic scene raises GraphError). The heat-only
+        engines take them; the engines with electrodes do not (an electrode selected by
+        position, or a wall, is not defined across the cell's images here).
 
     Attributes
     ----------
-    graph : the last ContactGraph (edges: the candidate pairs)
+    graph : the last ContactGraph (edges: the candidate pairs; in a periodic cell, positions
+        wrapped into the cell and each edge's image shift)
+    periodic : True when the scene's cell is periodic (at the last full read)
     list_builds : how many Verlet lists were made
     full_reads, calls, ignored, last_change : as :class:`~yade_electro.yade.scene.SceneReader`
     """
@@ -162,7 +180,8 @@ class GranularReader:
     #: ``SHRINK_FROM`` calls shrinks it
     GROW_BELOW, SHRINK_FROM = 6, 30
 
-    def __init__(self, O=None, mask: Optional[int] = None, skin="auto", walls: Optional[Dict] = None):
+    def __init__(self, O=None, mask: Optional[int] = None, skin="auto", walls: Optional[Dict] = None,
+                 periodic: bool = False):
         self.adaptive = isinstance(skin, str) and skin == "auto"
         if self.adaptive:
             skin = self.SKIN_START
@@ -189,6 +208,8 @@ class GranularReader:
         self._probe = None
         self._wall_geom: Dict[str, WallGeometry] = {}
         self._wall_contacts: Dict[str, tuple] = {}
+        self.periodic = False
+        self.accepts_periodic = bool(periodic)
 
     # -- public --------------------------------------------------------------------------
     def read(self) -> ContactGraph:
@@ -204,6 +225,10 @@ class GranularReader:
         if not np.all(np.isfinite(pos)):
             bad = self.graph.ids[~np.all(np.isfinite(pos), axis=1)]
             raise GraphError(f"spheres {bad[:10].tolist()} have non-finite positions (the mechanics blew up?)")
+        if self.periodic:
+            self.geometry_reads += 1
+            self._read_periodic(pos, bool(reason))
+            return self.graph
         geoms = {name: w.geometry(coords, self._slot_of) for name, w in self.walls.items()}
         self.geometry_reads += 1
         rebuild = bool(reason)
@@ -262,7 +287,12 @@ class GranularReader:
         return None
 
     def _full_read(self):
-        spheres = read_spheres(self.O, self.mask)
+        spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic)
+        self.periodic = bool(self.O.periodic)
+        if self.periodic and self.walls:
+            raise GraphError(f"walls ({sorted(self.walls)}) in a periodic cell are not supported: a sphere meets a "
+                             "wall only in the cell's own image here. Leave the walls out, or make the cell not "
+                             "periodic (O.periodic = False)")
         ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
         self._slot_of = spheres.slot_of
         self._node_slot = spheres.node_slot
@@ -277,7 +307,7 @@ class GranularReader:
         self._revision += 1
         self.graph = ContactGraph(spheres.pos, rad, np.zeros((0, 2), dtype=np.int64), ids, self._revision)
 
-    def _make_lists(self, pos, geoms):
+    def _adapt_skin(self):
         g = self.graph
         if self.adaptive and self.list_builds:
             lasted = self.calls - self._built_at
@@ -287,6 +317,50 @@ class GranularReader:
                 self.skin = max(self.skin / 1.25, self.SKIN_MIN)
             self._skin_m = self.skin * float(g.radius.min())
         self._built_at = self.calls
+
+    def _cell(self) -> np.ndarray:
+        """The periodic cell's base vectors [m] as columns (YADE's ``O.cell.hSize``)."""
+        h = self.O.cell.hSize
+        return np.array([[h[i, j] for j in range(3)] for i in range(3)], dtype=float)
+
+    def _read_periodic(self, raw, rebuild):
+        """The graph of a periodic bed from the centres ``raw`` [m] (YADE's, not wrapped)."""
+        H = self._cell()
+        if not (np.all(np.isfinite(H)) and abs(np.linalg.det(H)) > 0):
+            raise GraphError(f"the periodic cell is degenerate (O.cell.hSize = {H.tolist()})")
+        H_inv = np.linalg.inv(H)
+        s = raw @ H_inv.T                                   # the centres in cell periods
+        g = self.graph
+        if not rebuild:
+            # a pair's gap changes by at most |H_list| (|ds_i| + |ds_j|) + |H - H_list| |u|, u its
+            # separation in periods now, |u| <= |H^-1| 2 r_max for a pair that touches now
+            ds = s - self._list_s
+            moved = float(np.sqrt(np.max(np.einsum("ij,ij->i", ds, ds), initial=0.0)))
+            strain = np.linalg.norm(H - self._list_cell, 2) * np.linalg.norm(H_inv, 2) * 2.0 * float(g.radius.max())
+            rebuild = 2.0 * np.linalg.norm(self._list_cell, 2) * moved + strain > self._skin_m
+        periods = np.floor(s)
+        wrapped = (s - periods) @ H.T
+        if rebuild:
+            self._adapt_skin()
+            edges, self._images = periodic_candidate_pairs(raw, g.radius, self._skin_m, H)
+            self._list_s, self._list_cell = s, H
+            self.list_builds += 1
+            self._revision += 1
+            shift = (self._images + periods[edges[:, 1]] - periods[edges[:, 0]]) @ H.T
+            self.graph = ContactGraph(wrapped, g.radius, edges, g.ids, self._revision, shift=shift)
+            self.last_change = self.last_change or "new Verlet list"
+        else:
+            e = g.edges
+            shift = (self._images + periods[e[:, 1]] - periods[e[:, 0]]) @ H.T
+            if not (np.array_equal(wrapped, g.pos) and np.array_equal(shift, g.shift)):
+                self._revision += 1
+                self.graph = g.with_positions(wrapped, self._revision, shift=shift)
+                self.last_change = self.last_change or "geometry"
+        self._wall_geom, self._wall_contacts = {}, {}
+
+    def _make_lists(self, pos, geoms):
+        g = self.graph
+        self._adapt_skin()
         edges = candidate_pairs(pos, g.radius, self._skin_m)
         self._revision += 1
         self.graph = ContactGraph(pos, g.radius, edges, g.ids, self._revision)

@@ -6,8 +6,8 @@ What is read
 * nodes: bodies whose shape is a ``Sphere``; clumps and clump members, facets, walls, boxes
   and every other shape are left out (counted in ``SceneReader.ignored``; clumps left out
   are said in a log warning). An optional ``mask`` keeps only bodies with ``b.mask & mask``.
-  A periodic scene (``O.periodic``) is refused: lengths are taken from the positions,
-  without the cell's images.
+  A periodic scene (``O.periodic``) is refused here (lengths are taken from the positions,
+  without the cell's images); the granular reader takes it for heat conduction.
 * edges (``bonds='cohesive'``, the continuum mode): real sphere-sphere interactions that
   are cohesive bonds: ``CohFrictPhys`` with ``cohesionBroken == False``, ``JCFpmPhys`` with
   ``isCohesive == True``. With ``bonds='contacts'`` (granular mode) every real
@@ -27,7 +27,7 @@ Every other call compares a *stamp* of YADE's own C++ counters, about 0.6 ms in 
   uses it (O(1)): every JCFpm bond that breaks;
 * one body compared with the one kept (``O.bodies[i] == b``, a pointer comparison): the
   scene was replaced (``O.load``, ``O.reset``);
-* ``O.periodic`` (O(1)): the cell made periodic, which the next full read refuses.
+* ``O.periodic`` (O(1)): the cell made periodic (or not), which the next full read refuses.
 
 A CohFrictMat bond that breaks in shear while its spheres stay pressed together changes no
 counter. ``bond_check`` says how such breaks are found, with a cost of about 0.19 us per
@@ -94,19 +94,21 @@ class SphereBodies(NamedTuple):
     ignored: Counter           # what was left out, by reason
 
 
-#: why a periodic scene is refused (the readers take distances from the bodies' positions)
+#: why a periodic scene is refused (by the bonded reader, and for electrodes)
 PERIODIC_REFUSAL = (
-    "the scene has a periodic cell (O.periodic is True), which yade-electro does not support: it takes bond and "
-    "contact lengths from the bodies' positions without the cell's periodic images, so the bonds and contacts "
-    "that cross the cell's faces would be missing or given the wrong length. Run the packing in a box without "
-    "periodicity (walls or facets around it), or cut a piece out of the periodic packing")
+    "the scene has a periodic cell (O.periodic is True), which yade-electro supports only for heat conduction in "
+    "a granular bed (HeatEngine, or ElectroThermalEngine without electrodes, with bonds='contacts'): the bonded "
+    "reader takes bond lengths from the bodies' positions without the cell's periodic images, so the bonds across "
+    "the cell's faces would get the wrong length, and electrodes are not defined across the images. Run this "
+    "packing in a box without periodicity, or cut a piece out of the periodic packing")
 
 
-def read_spheres(O, mask: Optional[int] = None) -> SphereBodies:
+def read_spheres(O, mask: Optional[int] = None, periodic: bool = False) -> SphereBodies:
     """Every body whose shape is a ``Sphere`` (not a clump or clump member, and with ``b.mask &
     mask`` when a mask is given), by a Python loop over ``O.bodies``. GraphError when there is
-    none, a radius is not finite and > 0, or the scene is periodic (:data:`PERIODIC_REFUSAL`)."""
-    if O.periodic:
+    none, a radius is not finite and > 0, or the scene is periodic and the caller does not
+    take ``periodic`` cells (:data:`PERIODIC_REFUSAL`)."""
+    if O.periodic and not periodic:
         raise GraphError(PERIODIC_REFUSAL)
     Sphere = import_yade().Sphere
     ids, pos, rad, bodies, existing = [], [], [], [], []
