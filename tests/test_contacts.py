@@ -254,3 +254,32 @@ def test_periodic_graph_lengths_and_contact_factors():
     law = make_law("contact")
     a = math.sqrt(1e-3 ** 2 - 0.5e-3 ** 2)                   # lens of the 1 mm overlap
     assert law.factor(g) == pytest.approx([2 * a], rel=1e-12)
+
+
+def test_heat_carried_by_particles_closes_the_balance():
+    # a chain of four touching copper spheres, heat only, the first hot: then the hot one
+    # leaves, one grows, one is added at the reference temperature; the history's
+    # particle_heat is the heat each change took or brought, and the balance closes
+    r = 1e-3
+    C = 8900 * 172 * 4 / 3 * math.pi * r ** 3
+    pos = np.array([[i * 1.9e-3, 0, 0] for i in range(4)])
+    g = ContactGraph(pos, np.full(4, r), [[0, 1], [1, 2], [2, 3]], ids=[10, 11, 12, 13])
+    m = ElectroThermalModel(None, 8900, 172, 385, 300.0, law="contact", volume_fraction=1.0)
+    m.restore_temperatures(lambda graph: np.array([400.0, 300.0, 300.0, 300.0]))
+    start = m.refresh(g)["heat_content"]
+    for _ in range(5):
+        m.step(g, 1e-3)
+    T_hot = m.temperature[0]
+    g2 = ContactGraph(pos[1:], np.full(3, r), [[0, 1], [1, 2]], ids=[11, 12, 13])
+    row = m.step(g2, 1e-3)
+    assert row["particle_heat"] == pytest.approx(-C * (T_hot - 300.0), rel=1e-12)
+    T_grow = m.temperature[2]
+    g3 = ContactGraph(pos[1:], [r, r, 1.2 * r], [[0, 1], [1, 2]], ids=[11, 12, 13])
+    row3 = m.step(g3, 1e-3)
+    assert row3["particle_heat"] - row["particle_heat"] == pytest.approx(C * (1.2 ** 3 - 1) * (T_grow - 300.0),
+                                                                         rel=1e-9)
+    g4 = ContactGraph(np.vstack([pos[1:], [[7.6e-3, 0, 0]]]), [r, r, 1.2 * r, r], [[0, 1], [1, 2], [2, 3]],
+                      ids=[11, 12, 13, 14])
+    row4 = m.step(g4, 1e-3)
+    assert row4["particle_heat"] == row3["particle_heat"]        # added at the reference temperature
+    assert row4["heat_content"] - start == pytest.approx(row4["particle_heat"], rel=1e-12, abs=1e-15)

@@ -284,6 +284,31 @@ O.bodies[extra].shape.radius = 2e-4                        # a radius change
 e.step(); out["after_radius"] = [e.reader.full_reads, e.reader.last_change]
 O.bodies.erase(extra)                                     # an unbonded body erased
 e.step(); out["after_erase"] = [e.reader.full_reads, e.reader.last_change, int(e.bond_graph.n_nodes)]
+r0 = e.model.equivalent_resistance
+inner = int(ids[np.argmin(np.abs(z - 1e-3))])
+O.bodies[inner].shape.radius *= 1.3                       # a bonded sphere grows: its bonds conduct more
+e.step()
+fresh = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
+                                                      "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
+                         geometry_every=0, law=e.model.law_name, label="fresh")
+fresh.step()
+out["grown"] = [r0, e.model.equivalent_resistance, fresh.model.equivalent_resistance]
+# the continuum law's transmission surfaces go as r^2 (the voronoi law's faces do not see radii)
+cont = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
+                                                     "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
+                        geometry_every=0, law="continuum", label="cont")
+cont.step()
+r1 = cont.model.equivalent_resistance
+O.bodies[inner].shape.radius *= 1.3
+cont.step()
+fresh2 = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
+                                                       "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
+                          geometry_every=0, law="continuum", label="fresh2")
+fresh2.step()
+out["grown_continuum"] = [r1, cont.model.equivalent_resistance, fresh2.model.equivalent_resistance]
+for lab in ("fresh", "cont", "fresh2"):
+    O.engines = [x for x in O.engines if getattr(x, "label", "") != lab]
+e.step()                                                  # the second growth seen before the next check
 # a bond broken in shear with its spheres still in contact: no counter changes, the sweep finds it
 mid = [i for i in O.interactions if i.isReal and abs(O.bodies[i.id1].state.pos[2] - 1e-3) < 2e-4][0]
 mid.phys.cohesionBroken = True
@@ -307,6 +332,12 @@ def test_cheap_change_detection(run_yade_script):
     assert out["reads0"] == out["reads_unchanged"] == 1
     assert out["after_radius"][0] == 2 and "sphere volume" in out["after_radius"][1]
     assert out["after_erase"][0] == 3 and "sphere volume" in out["after_erase"][1]
+    # a grown radius changes the conductances as a fresh engine on the changed scene has them
+    # (the default law here is voronoi, whose faces do not depend on radii)
+    r0, r_kept, r_fresh = out["grown"]
+    assert r_kept == pytest.approx(r_fresh, rel=1e-9)
+    r1, r_kept, r_fresh = out["grown_continuum"]
+    assert r_kept < r1 and r_kept == pytest.approx(r_fresh, rel=1e-9)
     assert 1 <= out["sweep_calls_to_find"] <= 4                 # within sweep_calls
     assert out["negative_radius"][0] == "GraphError" and "radius must be finite and > 0" in out["negative_radius"][1]
 

@@ -419,7 +419,8 @@ class FactorNetwork:
     ``update(graph)`` compares the graph with the previous one and returns what changed:
 
     * ``None``: nothing (same object, or same elements, bonds and positions);
-    * ``'geometry'``: the elements moved: new factors g on the same edges;
+    * ``'geometry'``: the elements moved (or their periodic images, or their radii changed):
+      new factors g on the same edges;
     * ``'topology'``: the bonds changed and the law's new network is a subset of the kept
       edges (bonds broke): the lost edges get g = 0, the edge list stays;
     * ``'structure'``: another element set, or new edges: a new edge list.
@@ -438,7 +439,7 @@ class FactorNetwork:
         self.factor = None
         self._net = None
         self._slots = None
-        self._pos = self._shift = None
+        self._pos = self._shift = self._radius = None
 
     def update(self, graph: ContactGraph):
         from .network import edge_slots
@@ -452,7 +453,8 @@ class FactorNetwork:
         same_bonds = graph.edges is old.edges or np.array_equal(graph.edges, old.edges)
         moved = not (graph.pos is self._pos or np.array_equal(graph.pos, self._pos)) or not (
             graph.shift is self._shift or (graph.shift is not None and self._shift is not None
-                                           and np.array_equal(graph.shift, self._shift)))
+                                           and np.array_equal(graph.shift, self._shift))) or not (
+            graph.radius is self._radius or np.array_equal(graph.radius, self._radius))
         if same_bonds and not moved:
             return None
         kind = "geometry"
@@ -466,14 +468,14 @@ class FactorNetwork:
             kind = "topology"
         g = np.zeros(self.edges.shape[0])
         g[self._slots] = self.law.factor(graph, self._net)
-        self.factor, self._pos, self._shift = g, graph.pos, graph.shift
+        self.factor, self._pos, self._shift, self._radius = g, graph.pos, graph.shift, graph.radius
         return kind
 
     def _rebuild(self, graph):
         net = self.law.network(graph)
         self.edges, self._net, self._slots = net, net, np.arange(net.shape[0])
         self.factor = self.law.factor(graph, net)
-        self._pos, self._shift = graph.pos, graph.shift
+        self._pos, self._shift, self._radius = graph.pos, graph.shift, graph.radius
 
 
 __all__ += ["FactorNetwork"]

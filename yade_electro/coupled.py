@@ -241,7 +241,20 @@ class ElectroThermalModel:
         return edge_conductivity(lam, self.network.edges) * self.network.factor
 
     def prepare(self, graph: ContactGraph):
-        """Bring both models to ``graph`` (see the module doc)."""
+        """Bring both models to ``graph`` (see the module doc). Heat that the change of the
+        element set or of the capacities brings in or takes out (a particle erased while hot,
+        one added, a radius changed) goes into the ledger's ``exchange`` (``particle_heat``
+        of the history), so that the energy balance still closes."""
+        # the same graph object again (a step on an unchanged scene) changes no element
+        before = self.heat_content() if self.heat is not None and graph is not self._prepared else None
+        self._prepare_models(graph)
+        self._prepared = graph
+        if before is not None:
+            change = self.heat_content() - before
+            if change != 0.0:
+                self.heat.record_exchange(change)
+
+    def _prepare_models(self, graph: ContactGraph):
         if self.electrical is not None:
             kind = self.electrical.update(graph)
         else:
@@ -250,6 +263,7 @@ class ElectroThermalModel:
                 graph.ids, self._ids):
             self._new_heat_solver(graph)
             self._apply_walls(graph)
+            self._radius = graph.radius
             return
         walls_changed = self._apply_walls(graph, assemble=False)
         if walls_changed and kind not in ("structure", "topology", "geometry"):
@@ -261,7 +275,9 @@ class ElectroThermalModel:
             self.heat.update_edges(self.network.edges, self._thermal_conductance(graph),
                                    None if self.cell_volume is not None else self._capacities(graph))
         elif kind == "geometry":
-            self.heat.update_values(self._thermal_conductance(graph))
+            resized = self.cell_volume is None and not np.array_equal(graph.radius, self._radius)
+            self.heat.update_values(self._thermal_conductance(graph), self._capacities(graph) if resized else None)
+        self._radius = graph.radius
 
     # -- walls -------------------------------------------------------------------------------
     def set_wall_contacts(self, name: str, nodes, overlap):
@@ -347,6 +363,7 @@ class ElectroThermalModel:
                   graph.n_nodes, self.network.edges.shape[0], self.heat.critical_time_step)
 
     _T_restore = None
+    _prepared = None
 
     def _volumes(self, graph):
         """The volume each element stands for [m^3] (what its heat capacity is made of)."""
@@ -511,10 +528,11 @@ class ElectroThermalModel:
         joule_energy [J] (cumulative), heat_content [J], and, cumulative [J]: absorbed_heat
         (Joule heat generated on fixed-temperature elements, taken by their thermostat),
         boundary_heat, convection_heat, flux_heat (heat *received* by the solid from the
-        fixed-temperature elements, the ambient and imposed fluxes: negative when it leaves);
+        fixed-temperature elements, the ambient and imposed fluxes: negative when it leaves),
+        particle_heat (brought by elements added, taken by elements erased or resized);
         then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves.
         Balance: heat_content change = joule_energy - absorbed_heat + boundary_heat +
-        convection_heat + flux_heat."""
+        convection_heat + flux_heat + particle_heat."""
         heat = self.heat
         row = {"time": self.time, "dt": step.dt if step is not None else 0.0}
         if self.electrical is not None:
@@ -535,6 +553,7 @@ class ElectroThermalModel:
             "boundary_heat": heat.energy["boundary"],
             "convection_heat": heat.energy["convection"],
             "flux_heat": heat.energy["flux"],
+            "particle_heat": heat.energy["exchange"],
             "T_mean": float(np.sum(C * T) / np.sum(C)),
             "T_max": float(np.max(T)),
             "T_min": float(np.min(T)),

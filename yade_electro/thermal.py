@@ -560,7 +560,9 @@ class HeatSolver:
         'cg-deflated', 'direct' also work, the matrix is SPD)
     time : initial time [s]
     energy : dict, optional
-        Energy ledger to continue (see ``energy``), e.g. of a solver this one replaces.
+        Energy ledger to continue (see ``energy``), e.g. of a solver this one replaces. The
+        ledger [J]: ``source``, ``absorbed``, ``flux``, ``convection``, ``boundary`` (see
+        :class:`HeatStep`) and ``exchange`` (:meth:`record_exchange`).
     graph : ContactGraph, optional
         Lets boundary conditions use selectors / graph ids and default exposed areas.
     area : (n,) exposed areas [m^2], optional
@@ -715,7 +717,7 @@ class HeatSolver:
         self.time = float(time)
         self.steps = 0
         self.substeps = 0
-        self.energy = dict(source=0.0, absorbed=0.0, flux=0.0, convection=0.0, boundary=0.0)
+        self.energy = dict(source=0.0, absorbed=0.0, flux=0.0, convection=0.0, boundary=0.0, exchange=0.0)
         if energy:
             self.energy.update({k: float(v) for k, v in energy.items() if k in self.energy})
         #: heat [J] that entered through each linked condition since the start (walls, surfaces)
@@ -872,6 +874,15 @@ class HeatSolver:
                                "the state is unchanged")
         self._apply_fixed(T)
         self._T = T
+
+    def record_exchange(self, joules: float):
+        """Add ``joules`` [J] to the ledger's ``exchange``: heat that entered the network with
+        elements added, or left it with elements removed or resized (said by the owner that
+        changes the element set; no step makes it)."""
+        j = float(joules)
+        if not np.isfinite(j):
+            raise ThermalError(f"record_exchange: non-finite heat {joules!r}")
+        self.energy["exchange"] += j
 
     def set_fixed_temperature(self, name: str, temperature: float):
         """Change the value of a fixed-temperature set (from the next step on)."""
