@@ -283,3 +283,24 @@ def test_heat_carried_by_particles_closes_the_balance():
     row4 = m.step(g4, 1e-3)
     assert row4["particle_heat"] == row3["particle_heat"]        # added at the reference temperature
     assert row4["heat_content"] - start == pytest.approx(row4["particle_heat"], rel=1e-12, abs=1e-15)
+
+
+def test_candidate_pairs_over_a_wide_size_spread():
+    # radii spread over a factor 25 (size classes): the same pairs as the brute force, plain
+    # and periodic
+    from yade_electro.contacts import SIZE_CLASS_RATIO, periodic_candidate_pairs
+    rng = np.random.default_rng(11)
+    n = 500
+    rad = np.exp(rng.uniform(np.log(0.2e-3), np.log(5e-3), n))
+    assert rad.max() / rad.min() > 10 * SIZE_CLASS_RATIO
+    pos = rng.uniform(0, 0.05, (n, 3))
+    skin = 0.1e-3
+    got = candidate_pairs(pos, rad, skin)
+    d = np.linalg.norm(pos[:, None] - pos[None], axis=2)
+    i, j = np.nonzero(np.triu(d < rad[:, None] + rad[None] + skin, 1))
+    assert len(got) > 200 and np.array_equal(got, np.column_stack([i, j]))
+    H = np.diag([0.05, 0.05, 0.05]) + np.array([[0, 0.01, 0], [0, 0, 0], [0, 0, 0]])
+    pos = (rng.random((n, 3)) + rng.integers(-2, 3, size=(n, 3))) @ H.T
+    pairs, images = periodic_candidate_pairs(pos, rad, skin, H)
+    assert {(int(a), int(b), *c.tolist()) for (a, b), c in zip(pairs, images)} == \
+        _periodic_brute_force(pos, rad, skin, H)

@@ -43,19 +43,55 @@ def sphere_tree(pos):
     return cKDTree(np.asarray(pos, dtype=float))
 
 
+#: radii within this ratio are searched together; a wider spread is split into classes of radii
+#: within a factor 2, so that a few large spheres do not widen the search of every small one
+#: (one sphere 10 times larger among 20,000 took a list 6.1 s instead of 14 ms, 30 times larger 52 s)
+SIZE_CLASS_RATIO = 2.0
+
+
+def _pairs_within_reach(pos, radius, skin: float, tree=None) -> np.ndarray:
+    """Pairs (i < j, unsorted) closer than a reach that bounds r_i + r_j + skin: 2 r_max +
+    skin when the radii are within :data:`SIZE_CLASS_RATIO`, else per pair of size classes
+    (each class's largest radii)."""
+    r_min, r_max = float(radius.min()), float(radius.max())
+    if r_max <= SIZE_CLASS_RATIO * r_min:
+        cut = 2.0 * r_max + float(skin)
+        pairs = _cell_pairs(pos, cut) if tree is None else None     # (i < j already)
+        if pairs is None:
+            tree = sphere_tree(pos) if tree is None else tree
+            pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
+            pairs.sort(axis=1)
+        return pairs
+    from scipy.spatial import cKDTree
+    cls = np.floor(np.log2(radius / r_min)).astype(np.int64)
+    members = [m for m in (np.flatnonzero(cls == k) for k in range(int(cls.max()) + 1)) if m.size]
+    reach = [float(radius[m].max()) for m in members]
+    trees = [cKDTree(pos[m]) for m in members]
+    out = [np.zeros((0, 2), dtype=np.int64)]
+    for a, m in enumerate(members):
+        if m.size >= 2:
+            cut = 2.0 * reach[a] + float(skin)
+            p = _cell_pairs(pos[m], cut)
+            if p is None:
+                p = trees[a].query_pairs(cut, output_type="ndarray").astype(np.int64)
+            out.append(m[p])
+        for b in range(a + 1, len(members)):
+            close = trees[a].sparse_distance_matrix(trees[b], reach[a] + reach[b] + float(skin), output_type="ndarray")
+            out.append(np.column_stack([m[close["i"]], members[b][close["j"]]]).astype(np.int64))
+    pairs = np.concatenate(out)
+    pairs.sort(axis=1)
+    return pairs
+
+
 def candidate_pairs(pos, radius, skin: float, tree=None) -> np.ndarray:
     """Every pair (i < j) with ``|x_i - x_j| < r_i + r_j + skin`` [m], as an (m, 2) array in
-    lexicographic order; ``tree``: :func:`sphere_tree` of ``pos`` if already made."""
+    lexicographic order; ``tree``: :func:`sphere_tree` of ``pos`` if already made. Radii
+    spread wider than :data:`SIZE_CLASS_RATIO` are searched by size classes."""
     pos = np.asarray(pos, dtype=float)
     radius = np.asarray(radius, dtype=float)
     if pos.shape[0] < 2:
         return np.zeros((0, 2), dtype=np.int64)
-    cut = 2.0 * float(radius.max()) + float(skin)
-    pairs = _cell_pairs(pos, cut) if tree is None else None     # (i < j already)
-    if pairs is None:
-        tree = sphere_tree(pos) if tree is None else tree
-        pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
-        pairs.sort(axis=1)
+    pairs = _pairs_within_reach(pos, radius, skin, tree)
     if pairs.size == 0:
         return np.zeros((0, 2), dtype=np.int64)
     d = np.sqrt(((pos[pairs[:, 0]] - pos[pairs[:, 1]]) ** 2).sum(axis=1))
@@ -119,9 +155,7 @@ def periodic_candidate_pairs(pos, radius, skin: float, cell):
         img.append(np.tile(np.array(k, dtype=np.int64), (sel.size, 1)))
     idx, img = np.concatenate(idx), np.concatenate(img)
     X = (w[idx] + img) @ H.T
-    found = _cell_pairs(X, cut)
-    if found is None:
-        found = sphere_tree(X).query_pairs(cut, output_type="ndarray").astype(np.int64)
+    found = _pairs_within_reach(X, radius[idx], skin)
     if found.size == 0:
         return empty
     a, b = found[:, 0], found[:, 1]
