@@ -324,3 +324,71 @@ def test_granular_save_and_load_continues(run_yade_script, tmp_path):
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
     assert out["wall_heat"] == pytest.approx(ref["wall_heat"], rel=1e-9) and ref["wall_heat"] > 0
     assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)
+
+
+MATERIALS = r"""
+import json, math
+import numpy as np
+from yade import utils
+from yade_electro.yade import ElectricalEngine, HeatEngine
+cu = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5, label="cu"))
+steel = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5, label="steel"))
+r = 2e-3
+a_id = O.bodies.append(utils.sphere((0, 0, 0), r, material=cu))
+b_id = O.bodies.append(utils.sphere((3.8e-3, 0, 0), r, material=steel))
+far = O.bodies.append(utils.sphere((0.1, 0, 0), r, material=steel))       # alone, hot, erased later
+O.dt = 1e-3
+out = {}
+e = HeatEngine(8900, 172, 385, 273.15, initial_temperature={a_id: 373.15, far: 473.15}, bonds="contacts",
+               law="contact", theta="backward-euler", iterPeriod=1, label="heat",
+               materials={"steel": dict(density=7850, specific_heat=470, conductivity=50)})
+O.engines = [e.runner]
+O.run(50, True)
+O.bodies.erase(far)
+O.run(50, True)
+V = 4 / 3 * math.pi * r ** 3
+C1, C2 = 8900 * 172 * V, 7850 * 470 * V
+a = math.sqrt(r ** 2 - 1.9e-3 ** 2)
+H = 2 * (2 * 385 * 50 / (385 + 50)) * a
+T = e.temperature_by_id
+steps = round(e.coupled.time / 1e-3)
+out["heat"] = dict(D=T[a_id] - T[b_id], D_exact=100.0 * (1 + 1e-3 * H * (1 / C1 + 1 / C2)) ** -steps,
+                   sum=C1 * T[a_id] + C2 * T[b_id], sum0=C1 * 373.15 + C2 * 273.15, steps=steps,
+                   particle_heat=e.history.rows[-1]["particle_heat"], far_heat=-C2 * 200.0)
+O.engines = []
+el = ElectricalEngine(1e-6, {"a": dict(select=[a_id], potential=1.0), "b": dict(select=[b_id], potential=0.0)},
+                      bonds="contacts", law="contact", label="el", materials={"steel": dict(resistivity=5e-6)})
+el.step()
+out["R"] = [el.model.equivalent_resistance, 0.5 * (1e-6 + 5e-6) / (2 * a)]
+bad = {"label": {"glass": dict(conductivity=1.0)}, "index": {7: dict(conductivity=1.0)},
+       "property": {"cu": dict(emissivity=0.5)}, "negative": {"cu": dict(conductivity=-1.0)},
+       "resistivity_heat_only": {"cu": dict(resistivity=1e-6)}, "not_a_dict": ["cu"]}
+for name, m in bad.items():
+    try:
+        HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact", label="bad_" + name, materials=m)
+        out[name] = "accepted"
+    except Exception as exc:
+        out[name] = f"{type(exc).__name__}: {exc}"
+print(json.dumps(out))
+"""
+
+
+def test_particles_of_two_materials(run_yade_script, tmp_path):
+    # copper and steel spheres in contact (materials= by YADE material label): the temperature
+    # difference decays by the exact backward-Euler factor of H (1/C1 + 1/C2), H = 2 k_e a with
+    # k_e the harmonic mean; the heat is conserved; a hot steel sphere leaving takes its m c dT;
+    # electrically the edge takes the mean resistivity: R = (rho_1 + rho_2) / 2 / (2 a)
+    out = run_yade_script(MATERIALS, timeout=120, cwd=tmp_path, check=True).result
+    h = out["heat"]
+    assert h["steps"] == 99 and h["D"] == pytest.approx(h["D_exact"], rel=1e-9)
+    assert h["sum"] == pytest.approx(h["sum0"], rel=1e-12)
+    assert h["particle_heat"] == pytest.approx(h["far_heat"], rel=1e-12)
+    assert out["R"][0] == pytest.approx(out["R"][1], rel=1e-12)
+    assert "no material labelled 'glass'" in out["label"] and "['cu', 'steel']" in out["label"]
+    assert "no material 7 in O.materials" in out["index"]
+    assert "unknown property ['emissivity']" in out["property"]
+    assert "must be > 0" in out["negative"]
+    assert "unknown property ['resistivity']" in out["resistivity_heat_only"]
+    assert "must be a dict" in out["not_a_dict"]
+    for key in ("label", "index", "property", "negative", "resistivity_heat_only", "not_a_dict"):
+        assert out[key].startswith("MaterialError"), out[key]

@@ -30,6 +30,7 @@ Units: SI; temperatures in K (or degC if T_0 and every temperature are in degC).
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 from typing import Mapping, Optional, Sequence
 
@@ -246,8 +247,12 @@ class ElectroThermalModel:
         one added, a radius changed) goes into the ledger's ``exchange`` (``particle_heat``
         of the history), so that the energy balance still closes."""
         # the same graph object again (a step on an unchanged scene) changes no element
-        before = self.heat_content() if self.heat is not None and graph is not self._prepared else None
+        fresh = graph is not self._prepared or self._materials_changed
+        before = self.heat_content() if self.heat is not None and fresh else None
         self._prepare_models(graph)
+        if self._materials_changed:
+            self.heat.update_values(self._thermal_conductance(graph), self._capacities(graph))
+            self._materials_changed = False
         self._prepared = graph
         if before is not None:
             change = self.heat_content() - before
@@ -364,6 +369,7 @@ class ElectroThermalModel:
 
     _T_restore = None
     _prepared = None
+    _materials_changed = False
 
     def _volumes(self, graph):
         """The volume each element stands for [m^3] (what its heat capacity is made of)."""
@@ -383,6 +389,23 @@ class ElectroThermalModel:
             else:
                 np.add.at(q, nodes, src.density * v)
         return q
+
+    def set_material(self, **properties):
+        """New material data from the next step on: ``density`` [kg/m^3], ``specific_heat``
+        [J/(kg K)], ``conductivity`` [W/(m K)], ``resistivity`` (rho_0) [ohm m], each a scalar
+        or one value per element of the next graph (e.g. elements of several materials, given
+        again when the element set changes). Capacities and conductances follow at the next
+        :meth:`prepare`; the heat a capacity change brings goes into ``particle_heat``."""
+        unknown = set(properties) - {"density", "specific_heat", "conductivity", "resistivity"}
+        if unknown:
+            raise ValueError(f"set_material: unknown properties {sorted(unknown)}")
+        if "resistivity" in properties and self.electrical is None:
+            raise MaterialError("a heat-only model has no resistivity")
+        self.material = dataclasses.replace(self.material, **properties)
+        if "resistivity" in properties:
+            self.electrical.set_resistivity(self.material.resistivity)
+            self._rho_solved = None
+        self._materials_changed = True
 
     def restore_temperatures(self, fn):
         """Temperatures of the first graph from ``fn(graph) -> (n,)`` (a resumed run)."""

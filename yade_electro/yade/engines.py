@@ -39,7 +39,7 @@ import numpy as np
 
 from ..coupled import ElectroThermalModel
 from ..electrical import ElectricalModel, ElectrodeSpec
-from ..errors import BoundaryConditionError, ThermalError
+from ..errors import BoundaryConditionError, MaterialError, ThermalError
 from ..geometry import Shape, as_shape
 from ..history import History
 from ..materials import real_number
@@ -69,6 +69,51 @@ def _electrode_walls(electrodes) -> dict:
     return out
 
 
+def material_table(O, materials, allowed) -> Dict[int, Dict[str, float]]:
+    """``materials={YADE material label or index: dict(property=value)}`` checked against
+    ``O.materials`` and the ``allowed`` property names, as {material index: {name: value}}
+    (values finite and > 0, SI units). MaterialError saying what to fix."""
+    if materials is None:
+        return {}
+    if not isinstance(materials, dict):
+        raise MaterialError("materials= must be a dict YADE material (label or index in O.materials) -> "
+                            f"dict({', '.join(f'{a}=...' for a in allowed)}), got {type(materials).__name__}")
+    labels = {}
+    for k, m in enumerate(O.materials):
+        labels.setdefault(m.label, []).append(k)
+    out = {}
+    for key, values in materials.items():
+        if isinstance(key, str):
+            found = labels.get(key, [])
+            if len(found) != 1:
+                known = sorted(lab for lab in labels if lab)
+                raise MaterialError(f"materials: {'no' if not found else 'more than one'} material labelled {key!r} in "
+                                    f"O.materials (labels: {known}); give a unique label or the material's index")
+            mid = found[0]
+        elif isinstance(key, (int, np.integer)) and not isinstance(key, bool):
+            if not 0 <= int(key) < len(O.materials):
+                raise MaterialError(f"materials: no material {key} in O.materials (it has {len(O.materials)})")
+            mid = int(key)
+        else:
+            raise MaterialError(f"materials: a key must be a material's label or index in O.materials, got {key!r}")
+        if not isinstance(values, dict) or not values:
+            raise MaterialError(f"materials[{key!r}]: give dict({', '.join(f'{a}=...' for a in allowed)})")
+        unknown = sorted(set(values) - set(allowed))
+        if unknown:
+            raise MaterialError(f"materials[{key!r}]: unknown propert{'y' if len(unknown) == 1 else 'ies'} "
+                                f"{unknown}; this engine takes {list(allowed)}")
+        checked = {}
+        for name, v in values.items():
+            x = real_number(f"materials[{key!r}][{name!r}]", v)
+            if not x > 0:
+                raise MaterialError(f"materials[{key!r}][{name!r}] must be > 0, got {v!r}")
+            checked[name] = x
+        if mid in out:
+            raise MaterialError(f"materials: material {key!r} is given twice (by label and by index)")
+        out[mid] = checked
+    return out
+
+
 def _check_period(iterPeriod):
     if isinstance(iterPeriod, bool) or not isinstance(iterPeriod, (int, np.integer)) or iterPeriod <= 0:
         raise ValueError(f"iterPeriod must be an integer >= 1 (steps between two calls), got {iterPeriod!r}")
@@ -81,6 +126,10 @@ class _Engine:
     DEFAULT_LABEL = "electro"
     #: heat conduction only (no electrodes): periodic cells are taken in the granular mode
     _heat_only = False
+    #: per-material properties {YADE material index: {name: value}} (see ``materials=``)
+    _materials: Dict[int, Dict[str, float]] = {}
+    _materials_config = None
+    _materials_at = None
 
     def _start(self, O, label, resume, iterPeriod, reader_options, history, history_mode, write_back, plot):
         yade = import_yade()
@@ -123,6 +172,28 @@ class _Engine:
                 return np.array([bool(b.mask & int(m)) for b in reader.bodies])
             return by_mask
         return sel
+
+    def _apply_materials(self):
+        """Give the models per-element properties from the YADE materials of the elements read
+        (again only after a full read: the element set changes only there)."""
+        if not self._materials or self._materials_at == self.reader.full_reads:
+            return
+        mat_ids = np.array([b.material.id for b in self.reader.bodies], dtype=np.int64)
+        base = self._material_base()
+        props = {}
+        for name in sorted({k for v in self._materials.values() for k in v}):
+            arr = np.full(mat_ids.size, np.nan)
+            if base.get(name) is not None:
+                arr[:] = float(base[name])
+            for mid, values in self._materials.items():
+                if name in values:
+                    arr[mat_ids == mid] = values[name]
+            if np.isnan(arr).any():
+                raise MaterialError(f"{name} is given for some materials only and not to the engine: elements of "
+                                    f"the other materials have none; give {name}= to the engine too")
+            props[name] = arr
+        self._set_properties(props)
+        self._materials_at = self.reader.full_reads
 
     def _finish(self, history_mode):
         """After the model is built: first read, checks, history, runner, saved config."""
@@ -259,6 +330,10 @@ class ElectricalEngine(_Engine):
     ----------
     resistivity : float
         rho_e [ohm m].
+    materials : dict YADE material -> dict(resistivity=ohm m), optional
+        Elements of several materials: the key is a material of ``O.materials`` (its label,
+        or its index); its spheres take that resistivity, the others ``resistivity``. Looked
+        up again whenever the element set changes. An edge takes the mean of its two ends'.
     electrodes : dict name -> dict(select=... | surface=... | wall=..., potential=V | current=A)
         ``select``: an element layer (predicate, ids, mask; paper 000's electrodes).
         ``surface``: a surface of the container (``container.face('top')``, a ``Plane``, a
@@ -301,7 +376,7 @@ class ElectricalEngine(_Engine):
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, container=None, skin="auto", O=None, _resume=None):
+                 reselect: bool = False, container=None, skin="auto", materials=None, O=None, _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
                               skin=skin, walls=_electrode_walls(electrodes) or None)
@@ -309,6 +384,8 @@ class ElectricalEngine(_Engine):
         self._electrode_walls = _electrode_walls(electrodes)
         self._declared_walls = list(self._electrode_walls)
         self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
+        self._materials = material_table(self.O, materials, ("resistivity",))
+        self._materials_config = materials
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
@@ -399,7 +476,8 @@ class ElectricalEngine(_Engine):
                     bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
                     move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                     bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
-                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"])
+                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"],
+                    materials=self._materials_config)
 
     def _save_state(self):
         persistence.save_state(self.O, self.label, {
@@ -411,7 +489,14 @@ class ElectricalEngine(_Engine):
             for k, v in (self._resume_state.get("values") or {}).items():
                 self.model.set_electrode(k, v)
         self._feed_electrode_walls()
+        self._apply_materials()
         self.model.update(graph)
+
+    def _material_base(self):
+        return {"resistivity": self._resistivity}
+
+    def _set_properties(self, props):
+        self.model.set_resistivity(props["resistivity"])
 
     def _feed_electrode_walls(self):
         if self.model is None:
@@ -427,6 +512,7 @@ class ElectricalEngine(_Engine):
     def _step(self):
         graph = self.reader.read()
         self._feed_electrode_walls()
+        self._apply_materials()
         sol = self.model.solve(graph)
         if self.write_back and sol is not self._written:
             write_body_attribute(self.reader.bodies, self.write_back, sol.potential)
@@ -548,6 +634,12 @@ class ElectroThermalEngine(ElectricalEngine):
         isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.thermal.ThermalWall``.
         Their heat is in the history (``wall_heat:<name>``) and in :meth:`wall_heat`.
     skin : Verlet skin of the granular mode (see ElectricalEngine)
+    materials : dict YADE material -> dict(density=, specific_heat=, conductivity=, resistivity=), optional
+        Elements of several materials: the key is a material of ``O.materials`` (its label, or
+        its index), the values override the engine's for the spheres of that material (the
+        others keep them). Looked up again whenever the element set changes (a full read).
+        Edges take the harmonic mean of their two conductivities and the mean of their
+        resistivities; a wall contact the harmonic mean of the particle's and the wall's.
     """
 
     DEFAULT_LABEL = "electrothermal"
@@ -562,7 +654,7 @@ class ElectroThermalEngine(ElectricalEngine):
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
                  label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
-                 O=None, _resume=None):
+                 materials=None, O=None, _resume=None):
         wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
@@ -583,6 +675,9 @@ class ElectroThermalEngine(ElectricalEngine):
                     write_back if electrodes is not None else None, plot)
         for w, ids in wall_specs:
             check_wall_bodies(self.O, w.name, ids)
+        allowed = ("density", "specific_heat", "conductivity") + (("resistivity",) if electrodes is not None else ())
+        self._materials = material_table(self.O, materials, allowed)
+        self._materials_config = materials
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         if temperature is None:
@@ -727,6 +822,7 @@ class ElectroThermalEngine(ElectricalEngine):
         t = dict(self._thermal)
         t["walls"] = dict(self._walls) or None
         t["skin"] = self._options["skin"]
+        t["materials"] = self._materials_config
         bcs = {}
         for group in ("fixed", "flux", "convection"):
             out = []
@@ -758,10 +854,19 @@ class ElectroThermalEngine(ElectricalEngine):
             for k, v in (self._resume_state.get("values") or {}).items():
                 self.model.set_electrode(k, v)
         self._feed_walls()
+        self._apply_materials()
         self.coupled.refresh(graph)
         if self._resume is not None:
             for k, v in (self._resume_state.get("fixed_values") or {}).items():
                 self.coupled.heat.set_fixed_temperature(k, v)
+
+    def _material_base(self):
+        t = self._thermal
+        return {"density": t["density"], "specific_heat": t["specific_heat"], "conductivity": t["conductivity"],
+                "resistivity": self._resistivity}
+
+    def _set_properties(self, props):
+        self.coupled.set_material(**props)
 
     def set_fixed_temperature(self, name: str, temperature: float):
         """Change a fixed-temperature boundary condition's value from the next call on."""
@@ -780,6 +885,7 @@ class ElectroThermalEngine(ElectricalEngine):
     def _step(self, steady=None):
         graph = self.reader.read()
         self._feed_walls()
+        self._apply_materials()
         if self.thermal_dt is not None:
             dt = self.thermal_dt
         else:
