@@ -392,3 +392,50 @@ def test_particles_of_two_materials(run_yade_script, tmp_path):
     assert "must be a dict" in out["not_a_dict"]
     for key in ("label", "index", "property", "negative", "resistivity_heat_only", "not_a_dict"):
         assert out[key].startswith("MaterialError"), out[key]
+
+
+SAVED_PERIODIC = r'''
+import json, math
+import numpy as np
+from yade import utils
+from yade_electro.yade import HeatEngine, attach
+def build():
+    n, a, r = 5, 0.004, 0.00201
+    O.periodic = True
+    O.cell.setBox(n * a, n * a, n * a)
+    cu = O.materials.append(FrictMat(young=1.0, poisson=0.3, density=8900, frictionAngle=0.5, label="cu"))
+    st = O.materials.append(FrictMat(young=1.0, poisson=0.3, density=7850, frictionAngle=0.5, label="steel"))
+    ids = [O.bodies.append(utils.sphere(((i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a), r, material=cu if k % 2 else st))
+           for i in range(n) for j in range(n) for k in range(n)]
+    for b in ids:
+        O.bodies[b].state.vel = (0.3, 0.2, 0.1)
+    O.engines = [ForceResetter(), NewtonIntegrator(gravity=(0, 0, 0))]
+    O.dt = 1e-4
+    init = {b: 300.0 + 10.0 * math.cos(2 * math.pi * O.bodies[b].state.pos[0] / (n * a)) for b in ids}
+    e = HeatEngine(8900, 172, 385, 300.0, initial_temperature=init, bonds="contacts", law="contact",
+                   theta="backward-euler", iterPeriod=1, time_scale=100.0, history="h.csv",
+                   materials={"steel": dict(density=7850, specific_heat=470, conductivity=50)})
+    O.engines = O.engines + [e.runner]
+    return e
+def figures(e):
+    return dict(T={str(k): v for k, v in e.temperature_by_id.items()}, rows=len(e.history), time=e.coupled.time,
+                heat=e.history.rows[-1]["heat_content"])
+'''
+
+
+def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path):
+    import numpy as np
+    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
+    ref_dir.mkdir()
+    run_dir.mkdir()
+    ref = run_yade_script(SAVED_PERIODIC + "e = build()\nO.run(200, True)\nprint(json.dumps(figures(e)))\n",
+                          cwd=ref_dir, check=True).result
+    run_yade_script(SAVED_PERIODIC + "e = build()\nO.run(100, True)\nO.save('bed.yade.gz')\nprint('{}')\n",
+                    cwd=run_dir, check=True)
+    out = run_yade_script(SAVED_PERIODIC + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(100, True)\n"
+                          "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
+    assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
+    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
+    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
+    assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 300.0))
+    assert abs(ref["heat"]) < 1e-9 * 10.0 * 125 * 8900 * 172 * 4 / 3 * np.pi * 0.00201 ** 3   # a cosine: no net heat
