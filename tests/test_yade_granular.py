@@ -439,3 +439,56 @@ def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path
     tb = np.array([out["T"][k] for k in sorted(ref["T"])])
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 300.0))
     assert abs(ref["heat"]) < 1e-9 * 10.0 * 125 * 8900 * 172 * 4 / 3 * np.pi * 0.00201 ** 3   # a cosine: no net heat
+
+
+POURED = r"""
+import json, math
+import numpy as np
+from yade import utils
+from yade_electro.yade import HeatEngine
+mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
+r = 2e-3
+a = O.bodies.append(utils.sphere((0, 0, 0), r, material=mat))
+b = O.bodies.append(utils.sphere((3.8e-3, 0, 0), r, material=mat))
+wall = O.bodies.append(utils.wall((0, 0, -1), axis=2, material=mat))
+O.dt = 1e-3
+e = HeatEngine(8900, 172, 385, 300.0, initial_temperature={a: 350.0}, bonds="contacts", law="contact",
+               theta="backward-euler", iterPeriod=1, label="heat")
+O.engines = [e.runner]
+O.run(20, True)
+c = O.bodies.append(utils.sphere((7.6e-3, 0, 0), r, material=mat))      # poured in, touching b
+T_a = e.temperature_by_id[a]
+e.set_temperatures({c: 400.0, a: 320.0})
+O.run(1, True)
+row = e.history.rows[-1]
+C = 8900 * 172 * 4 / 3 * math.pi * r ** 3
+out = {"T_c": e.temperature_by_id[c], "particle_heat": row["particle_heat"], "heat": row["heat_content"],
+       "heat0": e.history.rows[0]["heat_content"], "expected": C * (400.0 - 300.0) + C * (320.0 - T_a)}
+O.run(20, True)
+out["heat_end"] = e.history.rows[-1]["heat_content"]
+out["particle_heat_end"] = e.history.rows[-1]["particle_heat"]
+errors = {}
+for name, t in {"wall": {wall: 300.0}, "missing": {99: 300.0}, "nan": {a: float("nan")}, "list": [a]}.items():
+    try:
+        e.set_temperatures(t)
+        errors[name] = "accepted"
+    except Exception as exc:
+        errors[name] = f"{type(exc).__name__}: {exc}"
+out["errors"] = errors
+print(json.dumps(out))
+"""
+
+
+def test_particles_poured_in_hot(run_yade_script, tmp_path):
+    # a sphere added during the run takes the temperature set for it (not the engine's
+    # default), and the heat this brings, like the one set on an old sphere, is in
+    # particle_heat: the balance of the adiabatic bed closes exactly
+    out = run_yade_script(POURED, timeout=120, cwd=tmp_path, check=True).result
+    assert 390.0 < out["T_c"] < 400.0                         # poured at 400 K, one step of conduction
+    assert out["heat"] - out["heat0"] == pytest.approx(out["particle_heat"], rel=1e-12)
+    assert out["heat_end"] == pytest.approx(out["heat"], rel=1e-12)       # adiabatic afterwards
+    assert out["particle_heat_end"] == out["particle_heat"]
+    assert out["particle_heat"] == pytest.approx(out["expected"], rel=1e-12)   # C (400 - 300) + C (320 - T_a)
+    for name, text in {"wall": "is not a sphere", "missing": "is not a sphere", "nan": "must be finite",
+                       "list": "takes a dict"}.items():
+        assert text in out["errors"][name], out["errors"][name]

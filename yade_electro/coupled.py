@@ -407,6 +407,22 @@ class ElectroThermalModel:
             self._rho_solved = None
         self._materials_changed = True
 
+    def set_temperatures(self, nodes, temperatures):
+        """Set the temperatures [K] of ``nodes`` of the current graph now (e.g. particles just
+        poured in hot); fixed-temperature nodes keep their imposed value. The heat this adds
+        or takes goes into the ledger's ``exchange`` (``particle_heat``)."""
+        if self.heat is None:
+            raise RuntimeError("no graph yet: call prepare(graph) or step first")
+        nodes = np.asarray(nodes, dtype=np.int64).reshape(-1)
+        values = np.asarray(temperatures, dtype=float).reshape(-1)
+        if values.shape != nodes.shape or (nodes.size and (nodes.min() < 0 or nodes.max() >= self.heat.n)):
+            raise ValueError(f"set_temperatures: give one temperature per node of the {self.heat.n}-node graph")
+        before = self.heat_content()
+        T = np.array(self.heat.temperature)
+        T[nodes] = values
+        self.heat.set_temperature(T)
+        self.heat.record_exchange(self.heat_content() - before)
+
     def restore_temperatures(self, fn):
         """Temperatures of the first graph from ``fn(graph) -> (n,)`` (a resumed run)."""
         self._T_restore = fn
@@ -552,7 +568,8 @@ class ElectroThermalModel:
         (Joule heat generated on fixed-temperature elements, taken by their thermostat),
         boundary_heat, convection_heat, flux_heat (heat *received* by the solid from the
         fixed-temperature elements, the ambient and imposed fluxes: negative when it leaves),
-        particle_heat (brought by elements added, taken by elements erased or resized);
+        particle_heat (brought by elements added, taken by elements erased or resized, or
+        set by :meth:`set_temperatures`);
         then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves.
         Balance: heat_content change = joule_energy - absorbed_heat + boundary_heat +
         convection_heat + flux_heat + particle_heat."""

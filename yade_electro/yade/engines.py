@@ -678,6 +678,7 @@ class ElectroThermalEngine(ElectricalEngine):
         allowed = ("density", "specific_heat", "conductivity") + (("resistivity",) if electrodes is not None else ())
         self._materials = material_table(self.O, materials, allowed)
         self._materials_config = materials
+        self._pending_temperatures: Dict[int, float] = {}
         law, law_params = self._law_and_container(law, law_params, container)
         self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
         if temperature is None:
@@ -886,6 +887,7 @@ class ElectroThermalEngine(ElectricalEngine):
         graph = self.reader.read()
         self._feed_walls()
         self._apply_materials()
+        self._apply_pending_temperatures(graph)
         if self.thermal_dt is not None:
             dt = self.thermal_dt
         else:
@@ -925,6 +927,44 @@ class ElectroThermalEngine(ElectricalEngine):
     @property
     def temperature_by_id(self) -> Dict[int, float]:
         return dict(zip(self.body_ids.tolist(), self.coupled.temperature.tolist()))
+
+    def set_temperatures(self, temperatures: Dict[int, float]):
+        """Give chosen spheres a temperature [K] at the next call, before its step:
+        ``{body id: K}``, for spheres the engine has or spheres added since (particles
+        poured in hot: they take it instead of ``temperature``). The heat this adds or takes
+        is in the history's ``particle_heat``, so the balance still closes. Checked now: an
+        id that is not a sphere of this scene (or is masked out), or a temperature that is not
+        a finite number, raises ValueError."""
+        if not hasattr(temperatures, "items"):
+            raise ValueError(f"set_temperatures takes a dict body id -> temperature (K), got "
+                             f"{type(temperatures).__name__}")
+        Sphere = import_yade().Sphere
+        mask = self.reader.mask
+        checked = {}
+        for k, v in temperatures.items():
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+                raise ValueError(f"set_temperatures: {k!r} is not a body id")
+            b = self.O.bodies[int(k)] if 0 <= int(k) < len(self.O.bodies) else None
+            if b is None or not isinstance(b.shape, Sphere) or b.isClump or b.isClumpMember:
+                raise ValueError(f"set_temperatures: body {k!r} is not a sphere of this scene (only spheres carry "
+                                 "temperatures)")
+            if mask is not None and not (b.mask & mask):
+                raise ValueError(f"set_temperatures: body {k} is masked out of this engine (mask={mask})")
+            checked[int(k)] = real_number(f"set_temperatures[{k}] (K)", v)
+        self._pending_temperatures.update(checked)
+
+    def _apply_pending_temperatures(self, graph):
+        if not self._pending_temperatures:
+            return
+        ids = np.array(sorted(self._pending_temperatures), dtype=np.int64)
+        here = np.isin(ids, graph.ids)
+        if not np.all(here):
+            log.warning("engine %r: set_temperatures for bodies %s that left the scene before the call; dropped",
+                        self.label, ids[~here][:10].tolist())
+        self.coupled.prepare(graph)
+        self.coupled.set_temperatures(graph.index_of(ids[here]),
+                                      [self._pending_temperatures[int(i)] for i in ids[here]])
+        self._pending_temperatures = {}
 
 
 class HeatEngine(ElectroThermalEngine):
