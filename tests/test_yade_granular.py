@@ -492,3 +492,55 @@ def test_particles_poured_in_hot(run_yade_script, tmp_path):
     for name, text in {"wall": "is not a sphere", "missing": "is not a sphere", "nan": "must be finite",
                        "list": "takes a dict"}.items():
         assert text in out["errors"][name], out["errors"][name]
+
+
+COMPRESSED = r"""
+import json
+import numpy as np
+from yade import pack, utils
+from yade_electro.yade import HeatEngine
+O.periodic = True
+L = 0.03
+O.cell.setBox(L, L, L)
+glass = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=2500, frictionAngle=0.5, label="glass"))
+cu = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5, label="cu"))
+sp = pack.SpherePack()
+sp.makeCloud((0, 0, 0), (L, L, L), rMean=1e-3, rRelFuzz=0.5, periodic=True, seed=3)     # radii over a factor 3
+ids = [O.bodies.append(utils.sphere(c, r, material=(cu if i % 3 == 0 else glass))) for i, (c, r) in enumerate(sp)]
+O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
+             InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_FrictMat_FrictMat_FrictPhys()],
+                             [Law2_ScGeom_FrictPhys_CundallStrack()]),
+             PeriIsoCompressor(charLen=2e-3, stresses=[-1e4, -1e5], doneHook="O.pause()", globalUpdateInt=20,
+                               keepProportions=True),
+             NewtonIntegrator(damping=0.4)]
+O.dt = 0.5 * utils.PWaveTimeStep()
+hot = {i: 400.0 for i in ids if O.bodies[i].state.pos[0] < L / 2}
+e = HeatEngine(2500, 800, 1.0, 300.0, initial_temperature=hot, bonds="contacts", law="contact",
+               theta="backward-euler", iterPeriod=20, label="heat",
+               materials={"cu": dict(density=8900, specific_heat=385, conductivity=385)})
+O.engines = O.engines + [e.runner]
+O.run(12000, True)
+e.step()                                  # the graph of the positions as they are now
+Hm = np.array([[O.cell.hSize[p, q] for q in range(3)] for p in range(3)])
+P = np.array([O.bodies[i].state.pos for i in ids])
+R = np.array([O.bodies[i].shape.radius for i in ids])
+S = P @ np.linalg.inv(Hm).T
+dS = S[None] - S[:, None]
+dS -= np.round(dS)
+brute = int(np.sum(np.triu(np.linalg.norm(dS @ Hm.T, axis=2) < R[:, None] + R[None, :], 1)))
+rows = e.history.rows
+print(json.dumps({"strain": 1 - Hm[0, 0] / L, "builds": e.reader.list_builds, "brute": brute,
+                  "ours": int(np.sum(e.contact_heat_flow()[1] > 0)), "heat0": rows[0]["heat_content"],
+                  "heat": rows[-1]["heat_content"], "T_max": rows[-1]["T_max"], "T_min": rows[-1]["T_min"]}))
+"""
+
+
+def test_periodic_bed_under_isotropic_compression(run_yade_script, tmp_path):
+    # a polydisperse two-material cloud in a periodic cell compressed by YADE's
+    # PeriIsoCompressor: the conducting contacts are those of the nearest images (brute force
+    # on YADE's cell), the adiabatic bed keeps its heat, and the hot half warms the cold one
+    out = run_yade_script(COMPRESSED, timeout=600, cwd=tmp_path, check=True).result
+    assert out["strain"] > 0.05 and out["builds"] > 10
+    assert out["ours"] == out["brute"] > 0
+    assert out["heat"] == pytest.approx(out["heat0"], rel=1e-12)
+    assert 300.0 < out["T_min"] + 1e-9 and out["T_max"] <= 400.0
