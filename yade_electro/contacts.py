@@ -50,19 +50,24 @@ def sphere_tree(pos):
 SIZE_CLASS_RATIO = 2.0
 
 
+def _pairs_closer_than(pos, cut: float, tree=None) -> np.ndarray:
+    """Pairs (i < j) of ``pos`` closer than ``cut`` [m]: the compiled cell grid, else
+    ``tree`` (a :func:`sphere_tree` of ``pos``, made when None)."""
+    pairs = _cell_pairs(pos, cut)                   # (i < j already)
+    if pairs is None:
+        tree = sphere_tree(pos) if tree is None else tree
+        pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
+        pairs.sort(axis=1)
+    return pairs
+
+
 def _pairs_within_reach(pos, radius, skin: float, tree=None) -> np.ndarray:
     """Pairs (i < j, unsorted) closer than a reach that bounds r_i + r_j + skin: 2 r_max +
     skin when the radii are within :data:`SIZE_CLASS_RATIO`, else per pair of size classes
     (each class's largest radii)."""
     r_min, r_max = float(radius.min()), float(radius.max())
     if r_max <= SIZE_CLASS_RATIO * r_min:
-        cut = 2.0 * r_max + float(skin)
-        pairs = _cell_pairs(pos, cut) if tree is None else None     # (i < j already)
-        if pairs is None:
-            tree = sphere_tree(pos) if tree is None else tree
-            pairs = tree.query_pairs(cut, output_type="ndarray").astype(np.int64)
-            pairs.sort(axis=1)
-        return pairs
+        return _pairs_closer_than(pos, 2.0 * r_max + float(skin), tree)
     from scipy.spatial import cKDTree
     cls = np.floor(np.log2(radius / r_min)).astype(np.int64)
     members = [m for m in (np.flatnonzero(cls == k) for k in range(int(cls.max()) + 1)) if m.size]
@@ -71,11 +76,7 @@ def _pairs_within_reach(pos, radius, skin: float, tree=None) -> np.ndarray:
     out = [np.zeros((0, 2), dtype=np.int64)]
     for a, m in enumerate(members):
         if m.size >= 2:
-            cut = 2.0 * reach[a] + float(skin)
-            p = _cell_pairs(pos[m], cut)
-            if p is None:
-                p = trees[a].query_pairs(cut, output_type="ndarray").astype(np.int64)
-            out.append(m[p])
+            out.append(m[_pairs_closer_than(pos[m], 2.0 * reach[a] + float(skin), trees[a])])
         for b in range(a + 1, len(members)):
             close = trees[a].sparse_distance_matrix(trees[b], reach[a] + reach[b] + float(skin), output_type="ndarray")
             out.append(np.column_stack([m[close["i"]], members[b][close["j"]]]).astype(np.int64))

@@ -344,18 +344,19 @@ class GranularReader:
             self._adapt_skin()
             edges, self._images = periodic_candidate_pairs(raw, g.radius, self._skin_m, H)
             self._list_s, self._list_cell = s, H
+        else:
+            edges = g.edges
+        # the images relative to the wrapped centres: the list's, plus each end's own periods
+        shift = (self._images + periods[edges[:, 1]] - periods[edges[:, 0]]) @ H.T
+        if rebuild:
             self.list_builds += 1
             self._revision += 1
-            shift = (self._images + periods[edges[:, 1]] - periods[edges[:, 0]]) @ H.T
             self.graph = ContactGraph(wrapped, g.radius, edges, g.ids, self._revision, shift=shift)
             self.last_change = self.last_change or "new Verlet list"
-        else:
-            e = g.edges
-            shift = (self._images + periods[e[:, 1]] - periods[e[:, 0]]) @ H.T
-            if not (np.array_equal(wrapped, g.pos) and np.array_equal(shift, g.shift)):
-                self._revision += 1
-                self.graph = g.with_positions(wrapped, self._revision, shift=shift)
-                self.last_change = self.last_change or "geometry"
+        elif not (np.array_equal(wrapped, g.pos) and np.array_equal(shift, g.shift)):
+            self._revision += 1
+            self.graph = g.with_positions(wrapped, self._revision, shift=shift)
+            self.last_change = self.last_change or "geometry"
         self._wall_geom, self._wall_contacts = {}, {}
 
     def _make_lists(self, pos, geoms):
