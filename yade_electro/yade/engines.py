@@ -47,7 +47,7 @@ from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource, Therma
 from . import persistence, registry
 from .runtime import import_yade
 from .granular import GranularReader, check_wall_bodies
-from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute, write_temperatures
+from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute
 
 __all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ensure_thermal_state", "engine_class"]
 
@@ -903,7 +903,7 @@ class ElectroThermalEngine(ElectricalEngine):
         if self._states_checked != self.reader.full_reads:    # the body set changes only there
             ensure_thermal_state(bodies)
             self._states_checked = self.reader.full_reads
-        write_temperatures(bodies, self.coupled.temperature)
+        write_body_attribute(bodies, "state.temp", self.coupled.temperature)
         sol = self.coupled.solution
         if self.write_back and sol is not None and sol is not self._written:
             write_body_attribute(bodies, self.write_back, sol.potential)

@@ -63,7 +63,7 @@ from ..errors import GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "write_body_attribute", "write_temperatures", "predicate_selector", "check_write_back",
+__all__ = ["SceneReader", "write_body_attribute", "predicate_selector", "check_write_back",
            "BOND_CHECKS", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced", "warn_left_out",
            "PERIODIC_REFUSAL"]
 
@@ -434,16 +434,14 @@ def write_body_attribute(bodies, name: str, values) -> None:
     """Set ``b.<name> = value`` on each body (a Python attribute YADE keeps on the body, so
     ``yade.export.VTKExporter(...).exportSpheres(what=dict(potential='b.potential'))`` and
     scripts can read it). YADE keeps such attributes only on bodies made in this process:
-    on a loaded scene read the values from the engine (``potential_by_id``)."""
-    # a C-level loop (map), a quarter faster than a Python for loop at 5,000 bodies
-    deque(map(setattr, bodies, repeat(name), np.asarray(values, dtype=float).tolist()), maxlen=0)
-
-
-def write_temperatures(bodies, values) -> None:
-    """Set ``b.state.temp = value`` [K] on each body (the states read afresh: a script may
-    have given a body a new state). A C-level loop: 0.56 against 0.65 ms for 2,000 bodies."""
-    states = map(operator.attrgetter("state"), bodies)
-    deque(map(setattr, states, repeat("temp"), np.asarray(values, dtype=float).tolist()), maxlen=0)
+    on a loaded scene read the values from the engine (``potential_by_id``). A dotted
+    ``name`` sets an attribute of a body's member, read afresh (``'state.temp'``: a script
+    may have given a body a new state)."""
+    # a C-level loop (map), a quarter faster than a Python for loop at 5,000 bodies (for
+    # 'state.temp', 0.56 against 0.65 ms at 2,000)
+    owner, _, attr = name.rpartition(".")
+    targets = map(operator.attrgetter(owner), bodies) if owner else bodies
+    deque(map(setattr, targets, repeat(attr), np.asarray(values, dtype=float).tolist()), maxlen=0)
 
 
 def predicate_selector(predicate, whole: bool = False):
