@@ -250,9 +250,7 @@ class ElectroThermalModel:
         fresh = graph is not self._prepared or self._materials_changed
         before = self.heat_content() if self.heat is not None and fresh else None
         self._prepare_models(graph)
-        if self._materials_changed:
-            self.heat.update_values(self._thermal_conductance(graph), self._capacities(graph))
-            self._materials_changed = False
+        self._materials_changed = False
         self._prepared = graph
         if before is not None:
             change = self.heat_content() - before
@@ -271,17 +269,20 @@ class ElectroThermalModel:
             self._radius = graph.radius
             return
         walls_changed = self._apply_walls(graph, assemble=False)
-        if walls_changed and kind not in ("structure", "topology", "geometry"):
+        refill = self._materials_changed        # new material data: conductances and capacities again
+        if walls_changed and not refill and kind not in ("structure", "topology", "geometry"):
             self.heat.update_values()
         if kind == "structure":
             self.heat.update_edges(self.network.edges, self._thermal_conductance(graph), self._capacities(graph))
             self.n_rebuilds += 1
         elif kind == "topology":
             self.heat.update_edges(self.network.edges, self._thermal_conductance(graph),
-                                   None if self.cell_volume is not None else self._capacities(graph))
+                                   None if self.cell_volume is not None and not refill else self._capacities(graph))
         elif kind == "geometry":
-            resized = self.cell_volume is None and not np.array_equal(graph.radius, self._radius)
+            resized = refill or self.cell_volume is None and not np.array_equal(graph.radius, self._radius)
             self.heat.update_values(self._thermal_conductance(graph), self._capacities(graph) if resized else None)
+        elif refill:
+            self.heat.update_values(self._thermal_conductance(graph), self._capacities(graph))
         self._radius = graph.radius
 
     # -- walls -------------------------------------------------------------------------------
