@@ -499,7 +499,7 @@ class DeflatedCGSolver(CGSolver):
             if not np.all(np.isfinite(x)):
                 raise _nonfinite_solution(self.name)
             _check_converged(self.name, res, nb, self.rtol, atol, it)
-            info = {"solver": self.name, "iterations": it, "residual": res, "setup": fresh,
+            info = {"solver": self.name, "iterations": it, "residual": res,
                     "setup_time": self.setup_time, "iteration_time": time.perf_counter() - t}
         info["setup"] = fresh                   # (the numpy path's own check finds the setup done)
         info["compiled"] = self._dcg is not None
