@@ -39,6 +39,41 @@ def test_triangle_distance_against_dense_sampling():
     assert np.max(brute - got) < 5e-3                     # the sampling's resolution
 
 
+def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
+    """The contact radii of native/contact_radii.cpp against the numpy form, both models, on
+    overlapping and separated pairs of a polydisperse cloud, with and without periodic image
+    shifts: the same a^2 to 1e-14 r_max^2 (a last-bit difference in the centre distance, numpy's
+    einsum sums the squares in another order, is amplified in a^2 = r1^2 - x^2 for small
+    contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way."""
+    import yade_electro.contacts as C
+    from yade_electro.conductance import contact_radius
+    from yade_electro.errors import MaterialError
+    from yade_electro.native import NativeError, contact_radii
+    try:
+        contact_radii(np.zeros((1, 3)), np.ones(1), np.zeros((0, 2), dtype=np.int64))
+    except NativeError as exc:
+        pytest.skip(f"the compiled helper does not build here: {exc}")
+    rng = np.random.default_rng(11)
+    pos = rng.uniform(0, 0.01, (500, 3))
+    rad = rng.uniform(0.4e-3, 1.2e-3, 500)
+    edges = candidate_pairs(pos, rad, 0.5e-3)
+    shift = rng.uniform(-1e-4, 1e-4, (edges.shape[0], 3))
+    for g in (ContactGraph(pos, rad, edges), ContactGraph(pos, rad, edges, shift=shift)):
+        for model in ("geometric", "hertz"):
+            monkeypatch.setattr(C, "NATIVE", True)
+            fast = contact_radius(g, model=model)
+            monkeypatch.setattr(C, "NATIVE", False)
+            slow = contact_radius(g, model=model)
+            assert np.count_nonzero(slow) > 100 and np.count_nonzero(slow == 0) > 100
+            assert np.array_equal(fast == 0, slow == 0)
+            assert np.allclose(fast ** 2, slow ** 2, rtol=0, atol=1e-14 * rad.max() ** 2)
+    same = ContactGraph([[0, 0, 0], [0, 0, 0]], [1.0, 1.0], [[0, 1]])
+    for native in (True, False):
+        monkeypatch.setattr(C, "NATIVE", native)
+        with pytest.raises(MaterialError, match="coincident"):
+            contact_radius(same)
+
+
 def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     """The compiled helpers (native/wall_contacts.cpp, the cell grid of fire_steps.cpp) against
     the numpy / cKDTree forms: triangle distances in every closest-point region (the same to

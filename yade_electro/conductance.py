@@ -49,6 +49,7 @@ from typing import Callable, Dict
 
 import numpy as np
 
+from .contacts import native_helper
 from .errors import MaterialError
 from .graph import ContactGraph
 from .materials import edge_resistivity, positive_property
@@ -183,10 +184,24 @@ def contact_radius(graph: ContactGraph, edges=None, model: str = "geometric") ->
     overlaps. ``model='hertz'``: the Hertz contact radius a = sqrt(R* delta), R* = r1 r2 /
     (r1 + r2), delta = r1 + r2 - d; for a Hertz contact under a force F (YADE's
     Hertz-Mindlin law), a = (3 F R* / (4 E*))^(1/3).
+
+    Compiled (:func:`yade_electro.native.contact_radii`, numpy's operations in one pass)
+    where it builds, else numpy.
     """
     if model not in CONTACT_RADII:
         raise ValueError(f"contact radius model must be one of {CONTACT_RADII}, got {model!r}")
     edges = graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    f = native_helper("contact_radii")
+    if f is not None and (graph.shift is None or edges is graph.edges):
+        from .native import NativeError
+        try:
+            a, coincident = f(graph.pos, graph.radius, edges, graph.shift, model)
+        except NativeError:
+            pass
+        else:
+            if coincident:
+                raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+            return a
     r1 = graph.radius[edges[:, 0]]
     r2 = graph.radius[edges[:, 1]]
     d = edge_lengths(graph, edges)

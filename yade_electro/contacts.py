@@ -290,7 +290,7 @@ class WallGeometry:
         return float(abs((self.point - other.point) @ self.normal))
 
 
-def _native(name):
+def native_helper(name):
     """The compiled helper ``name`` of :mod:`yade_electro.native`, or None (numpy) when it
     cannot be built or is switched off (``NATIVE = False``, for tests)."""
     if not NATIVE:
@@ -299,8 +299,8 @@ def _native(name):
     return getattr(native, name)
 
 
-#: use the compiled helpers (``native/wall_contacts.cpp``, ``fire_steps.cpp``'s cell grid)
-#: where they build; False: numpy and scipy's cKDTree only
+#: use the compiled helpers (``native/wall_contacts.cpp``, ``fire_steps.cpp``'s cell grid,
+#: ``contact_radii.cpp``) where they build; False: numpy and scipy's cKDTree only
 NATIVE = True
 
 
@@ -309,7 +309,7 @@ def triangle_distance(points, triangles) -> np.ndarray:
     closest point of the triangle, faces, edges or corners; Ericson, Real-Time Collision
     Detection, 5.1.5). Compiled (:func:`yade_electro.native.triangle_distance`, the same
     regions and precedence) where it builds, else numpy."""
-    f = _native("triangle_distance")
+    f = native_helper("triangle_distance")
     if f is not None:
         from .native import NativeError
         try:
@@ -379,7 +379,7 @@ def wall_candidates(wall: WallGeometry, pos, radius, skin: float, tree=None):
         return s, np.zeros(s.size, dtype=np.int64)
     c, rc = wall.reach()
     reach = rc + float(radius.max()) + float(skin)
-    f = _native("triangle_candidates")
+    f = native_helper("triangle_candidates")
     if f is not None and tree is None:
         from .native import NativeError
         try:

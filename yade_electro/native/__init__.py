@@ -30,6 +30,10 @@ at 20,000 (2026-12-03).
 the granular mode's facet walls (:func:`triangle_distance`, :func:`triangle_candidates`), the
 numpy form's closest-point regions in one compiled pass.
 
+``contact_radii``: the contact radius of each sphere pair of the granular mode's Verlet list
+(:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`), numpy's
+operations in one pass.
+
 ``soft_spheres``: the sphere-sphere forces of the jamming's overlap energy
 (:func:`soft_sphere_forces`), the same operations in the same order as the numpy form in
 :mod:`yade_electro.packing.jamming`, built without floating-point contraction, so that the
@@ -50,7 +54,7 @@ import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
-           "laplacian_fill", "triangle_distance", "triangle_candidates"]
+           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -413,6 +417,31 @@ def triangle_candidates(pos, radius, skin: float, triangles, centre, reach):
         if m <= room:
             return spheres[:m].copy(), pieces[:m].copy()
         room = m
+
+
+def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
+    """Contact radius a [m] of each sphere pair ``edges`` (m, 2) (0 where the spheres do not
+    overlap), as :func:`yade_electro.conductance.contact_radius` computes it with numpy
+    (``model`` 'geometric' or 'hertz'; ``shift`` (m, 3): the periodic image of the second
+    sphere), and the number of pairs with coincident centres (their radii are not
+    meaningful); ``contact_radii.cpp``, one pass. Raises :class:`NativeError` when it cannot
+    be built."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    f = _shared_function("contact_radii", "contact_radii", [i64, ptr, ptr, ptr, ptr, ctypes.c_int, ptr], i64,
+                         flags=["-ffp-contract=off"])
+    x = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
+    r = np.ascontiguousarray(radius, dtype=np.float64)
+    e = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
+    s = None if shift is None else np.ascontiguousarray(shift, dtype=np.float64).reshape(-1, 3)
+    if r.shape[0] != x.shape[0] or (s is not None and s.shape[0] != e.shape[0]):
+        raise ValueError("contact_radii: sizes do not match")
+    if e.size and (e.min() < 0 or e.max() >= x.shape[0]):
+        raise ValueError("contact_radii: a node index is out of range")
+    out = np.empty(e.shape[0])
+    bad = f(e.shape[0], x.ctypes.data, r.ctypes.data, e.ctypes.data, None if s is None else s.ctypes.data,
+            1 if model == "hertz" else 0, out.ctypes.data)
+    return out, int(bad)
 
 
 EIGEN_INCLUDE = "/usr/include/eigen3"
