@@ -79,3 +79,10 @@ def test_vtk_files_round_trip(tmp_path):
         write_elements(str(tmp_path / "x.vtu"), x, [1, 2, 3], {"potential": [1.0]})
     with pytest.raises(ValueError, match="bond indices"):
         write_bonds(str(tmp_path / "y.vtu"), x, [[0, 3]])
+    # periodic: bond (0, 2) crosses a face (its vector is to 2's image), bond (0, 1) does not
+    v = [[1e-3, 0, 0], [0, -1e-3, 0]]
+    m = meshio.read(write_bonds(str(tmp_path / "p.vtu"), x, [[0, 1], [0, 2]], {"q": [1.0, 2.0]}, vectors=v))
+    assert m.cells[0].data.tolist() == [[0, 1], [0, 3]] and np.allclose(m.points[3], [0, -1e-3, 0])
+    assert m.cell_data["q"][0].tolist() == [1.0, 2.0]
+    with pytest.raises(ValueError, match="vectors"):
+        write_bonds(str(tmp_path / "z.vtu"), x, [[0, 1]], vectors=[[0, 0, np.nan]])

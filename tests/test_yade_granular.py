@@ -184,6 +184,12 @@ steps = round((eng.coupled.time - t_start) / h)
 out.update(A_rel=A / (A_start * (1 + lam * h) ** -steps) - 1, mode_dev=float(np.max(np.abs(T - T0 - A * mode))),
            steps=steps, contacts=int(np.sum(eng.contact_heat_flow()[1] > 0)), crossed=float(max(
                O.bodies[i].state.pos[0] for i in ids)) > L)
+import meshio
+vtk = meshio.read(eng.write_vtk("bed")["contacts"])
+seg = vtk.points[vtk.cells_dict["line"]]
+out["vtk_lines"] = len(seg)
+out["vtk_longest"] = float(np.max(np.linalg.norm(seg[:, 1] - seg[:, 0], axis=1)))
+out["vtk_extra_points"] = len(vtk.points) - len(ids)
 # a deforming, shearing cell: the contacts against the nearest images of YADE's own cell
 O.cell.velGrad = Matrix3(0.5, 0, 0, 0, 0, 0, 0.2, 0, 0)
 agree = []
@@ -223,6 +229,10 @@ def test_periodic_cells_conduct_across_their_faces(run_yade_script, tmp_path):
     out = run_yade_script(PERIODIC, timeout=300, cwd=tmp_path, check=True).result
     assert out["box_contacts"] == 540 and out["contacts"] == 648 and out["crossed"]     # 3 n^2 (n - 1), 3 n^3
     assert out["steps"] == 200 and abs(out["A_rel"]) < 1e-9 and out["mode_dev"] < 1e-9
+    # VTK: each contact drawn to the neighbour's image (the centres' distance a), none across
+    # the cell; those crossing a face (3 n^2 of them) get their own end point
+    assert out["vtk_lines"] == 648 and out["vtk_longest"] == pytest.approx(0.004, rel=1e-9)
+    assert out["vtk_extra_points"] == 3 * 36
     counts = [c for c, _ in out["deforming"]]
     assert all(c == b for c, b in out["deforming"]) and counts[0] == 648 and counts[-1] == 432
     # refused: the bonded reader, electrodes and walls in a periodic cell
@@ -324,6 +334,26 @@ def test_granular_save_and_load_continues(run_yade_script, tmp_path):
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
     assert out["wall_heat"] == pytest.approx(ref["wall_heat"], rel=1e-9) and ref["wall_heat"] > 0
     assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)
+
+
+def test_temperatures_set_before_a_save_are_kept(run_yade_script, tmp_path):
+    # set_temperatures, then O.save before the engine's next call: the run loaded in a new
+    # process applies them at its first call, as the uninterrupted run does
+    import numpy as np
+    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
+    ref_dir.mkdir(), run_dir.mkdir()
+    hot = "e.set_temperatures({int(e.body_ids[0]): 500.0, int(e.body_ids[-1]): 450.0})\n"
+    ref = run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\n" + hot + "O.run(1000, True)\n"
+                          "print(json.dumps(figures(e)))\n", cwd=ref_dir, check=True).result
+    run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\n" + hot + "O.save('bed.yade.gz')\nprint('{}')\n",
+                    cwd=run_dir, check=True)
+    out = run_yade_script(SAVED_BED + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(1000, True)\n"
+                          "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
+    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
+    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
+    assert np.max(ta) > 380.0                                 # the 500 K particle is still hot
+    assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
+    assert out["heat"] == pytest.approx(ref["heat"], rel=1e-9)
 
 
 MATERIALS = r"""

@@ -738,6 +738,7 @@ class ElectroThermalEngine(ElectricalEngine):
             self._last_time = float(st.get("mech_time", self._last_time))
             self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
             self.coupled.restore_temperatures(self._read_temperatures)
+            self._pending_temperatures = {int(k): float(v) for k, v in (st.get("pending") or {}).items()}
         self._finish(history_mode)
 
     @staticmethod
@@ -786,6 +787,33 @@ class ElectroThermalEngine(ElectricalEngine):
         T = heat.temperature
         ids = self.body_ids
         return np.column_stack([ids[e[:, 0]], ids[e[:, 1]]]), G[on], G[on] * (T[e[:, 0]] - T[e[:, 1]])
+
+    def write_vtk(self, prefix: str) -> Dict[str, str]:
+        """Write the last call's state for ParaView (meshio, ``.vtu``): ``<prefix>_particles.vtu``
+        (points with ``radius`` [m], ``temperature`` [K], ``body_id``, and ``potential`` [V]
+        with electrodes) and ``<prefix>_contacts.vtu`` (a line per conducting contact, cell
+        data ``conductance_W_per_K``, ``heat_flow_W`` from the first body to the second, body
+        ids ``id1``, ``id2``). In a periodic cell, a contact that crosses a face is drawn to
+        the neighbour's image. Returns {'particles': path, 'contacts': path}."""
+        from ..vtk import write_bonds, write_elements
+        if self.coupled.heat is None:
+            raise RuntimeError(f"engine {self.label!r} has not run yet: call O.run (or engine.step()) first")
+        graph, net, heat = self.coupled.network.graph, self.coupled.network, self.coupled.heat
+        fields = {"temperature": heat.temperature, "body_id": graph.ids.astype(float)}
+        sol = self.coupled.solution
+        if sol is not None:
+            fields["potential"] = sol.potential
+        on = heat.conductance > 0
+        e = net.edges[on]
+        T = heat.temperature
+        out = {"particles": write_elements(f"{prefix}_particles.vtu", graph.pos, graph.radius, fields),
+               "contacts": write_bonds(f"{prefix}_contacts.vtu", graph.pos, e,
+                                       {"conductance_W_per_K": heat.conductance[on],
+                                        "heat_flow_W": heat.conductance[on] * (T[e[:, 0]] - T[e[:, 1]]),
+                                        "id1": graph.ids[e[:, 0]].astype(float),
+                                        "id2": graph.ids[e[:, 1]].astype(float)},
+                                       vectors=graph.edge_vectors(e) if graph.shift is not None else None)}
+        return out
 
     def _initial_temperatures(self, table, default):
         """A function graph -> starting temperatures from ``{body id: K}`` (checked now)."""
@@ -848,6 +876,7 @@ class ElectroThermalEngine(ElectricalEngine):
             "values": dict(self.model.values) if self.model is not None else {},
             "thermal_time": self.coupled.time, "energy": self.coupled.energy_ledger,
             "fixed_values": heat.fixed_values if heat is not None else {},
+            "pending": {str(k): v for k, v in self._pending_temperatures.items()},
             "rows": len(self.history)})
 
     def _prepare(self, graph):
@@ -931,7 +960,8 @@ class ElectroThermalEngine(ElectricalEngine):
         """Give chosen spheres a temperature [K] at the next call, before its step:
         ``{body id: K}``, for spheres the engine has or spheres added since (particles
         poured in hot: they take it instead of ``temperature``). The heat this adds or takes
-        is in the history's ``particle_heat``, so the balance still closes. Checked now: an
+        is in the history's ``particle_heat``, so the balance still closes. A scene saved
+        before that call (``O.save``) keeps them for the run that loads it. Checked now: an
         id that is not a sphere of this scene (or is masked out), or a temperature that is not
         a finite number, raises ValueError."""
         if not hasattr(temperatures, "items"):
@@ -951,6 +981,7 @@ class ElectroThermalEngine(ElectricalEngine):
                 raise ValueError(f"set_temperatures: body {k} is masked out of this engine (mask={mask})")
             checked[int(k)] = real_number(f"set_temperatures[{k}] (K)", v)
         self._pending_temperatures.update(checked)
+        self._save_state()                  # an O.save before the next call keeps them
 
     def _apply_pending_temperatures(self, graph):
         if not self._pending_temperatures:
