@@ -15,9 +15,13 @@ skipped), the order swapped every pair. Prints one JSON line per period::
      "engine_share_of_sums": 1 - 1 / ratio,
      "calls_share": time inside the engine's calls / wall_with,
      "call_ms": the engine's own time per call (measured inside the calls),
-     "yade_step_ms": wall_without / steps, "list_builds_per_call", "load"}
+     "yade_step_ms": wall_without / steps, "list_builds_per_call",
+     "yade_engines_ms_with", "yade_engines_ms_without": the time per step inside YADE's own
+         engines (their ``execTime``, ``O.timingEnabled``) with the engine alive and dead: how
+         much the engine's calls slow YADE's own work down between them,
+     "load"}
 
-    yade-electro -n -x bench/bench_granular.py [--n 2000] [--steps 500] [--pairs 8]
+    yade-electro -n -x bench/bench_granular.py [--n 2000] [--steps 100] [--pairs 40]
 """
 from __future__ import annotations
 
@@ -38,10 +42,13 @@ def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=2000)
     ap.add_argument("--rpm", type=float, default=20.0)
-    ap.add_argument("--steps", type=int, default=500, help="steps per timed block")
-    ap.add_argument("--pairs", type=int, default=8, help="pairs of blocks (with / without the engine)")
+    ap.add_argument("--steps", type=int, default=100, help="steps per timed block")
+    ap.add_argument("--pairs", type=int, default=40, help="pairs of blocks (with / without the engine)")
     ap.add_argument("--periods", default="10,100")
     ap.add_argument("--skin", type=float, default=None, help="Verlet skin in smallest radii (engine default)")
+    ap.add_argument("--reference", action="store_true",
+                    help="also time two stand-in PyRunners every 10 steps (no engine): a 6 ms Python spin and "
+                         "the sum of a fresh 16 MB array, to see how any Python work slows YADE's own engines")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     import numpy as np
     import rotating_drum as drum
@@ -54,6 +61,8 @@ def main(argv=None):
     sph = np.array(ids["spheres"])
     hot = sph[: sph.size // 2]
     out = []
+    if args.reference:
+        out += reference_rows(yade, O, args)
     for period in (int(p) for p in args.periods.split(",")):
         engine = drum.heat_engine(ids, hot, label="bench_granular", iterPeriod=period, skin=args.skin)
         O.engines = O.engines + [engine.runner]
@@ -70,16 +79,22 @@ def main(argv=None):
         engine._step = timed
         c0, b0 = engine.reader.calls, engine.reader.list_builds
         wall = {"with": 0.0, "without": 0.0}
+        own = {"with": 0.0, "without": 0.0}         # YADE's own engines (execTime, ns)
+        mechanics = [e for e in O.engines if type(e).__name__ != "PyRunner"]
+        O.timingEnabled = True
         pair_ratios = []
         for k in range(args.pairs):
             w = {}
             for mode in (("without", "with") if k % 2 == 0 else ("with", "without")):
                 engine.runner.dead = mode == "without"
+                e0 = sum(e.execTime for e in mechanics)
                 t = time.perf_counter()
                 O.run(args.steps, True)
                 w[mode] = time.perf_counter() - t
+                own[mode] += sum(e.execTime for e in mechanics) - e0
                 wall[mode] += w[mode]
             pair_ratios.append(w["with"] / w["without"])
+        O.timingEnabled = False
         calls = engine.reader.calls - c0
         builds = engine.reader.list_builds - b0
         engine.remove()
@@ -91,10 +106,55 @@ def main(argv=None):
                "call_ms": round(1e3 * spent[0] / max(calls, 1), 3),
                "yade_step_ms": round(1e3 * wall["without"] / (args.pairs * args.steps), 3),
                "list_builds_per_call": round(builds / max(calls, 1), 3),
+               "yade_engines_ms_with": round(1e-6 * own["with"] / (args.pairs * args.steps), 3),
+               "yade_engines_ms_without": round(1e-6 * own["without"] / (args.pairs * args.steps), 3),
                "load": round(os.getloadavg()[0], 2)}
         out.append(row)
         print(json.dumps(row), flush=True)
     return out
+
+
+def _spin(ms):
+    t = time.perf_counter()
+    while time.perf_counter() - t < ms * 1e-3:
+        pass
+
+
+def reference_rows(yade, O, args):
+    """Stand-ins for the engine, every 10 steps, blocks interleaved with dead ones as for the
+    engine: ``spin`` (a 6 ms pure-Python loop) and ``alloc`` (numpy sums a fresh 16 MB
+    array). One JSON line each: the time per step in YADE's own engines alive and dead."""
+    import builtins
+    builtins._bench_granular_spin = _spin
+    runners = {"spin": yade.PyRunner(command="__import__('builtins')._bench_granular_spin(6.0)", iterPeriod=10),
+               "alloc": yade.PyRunner(command="__import__('numpy').random.rand(2000000).sum()", iterPeriod=10)}
+    O.engines = O.engines + list(runners.values())
+    mechanics = [e for e in O.engines if type(e).__name__ != "PyRunner"]
+    O.timingEnabled = True
+    own, wall = {}, {}
+    for k in range(args.pairs):
+        modes = ["dead"] + list(runners)
+        for mode in (modes if k % 2 == 0 else modes[::-1]):
+            for name, r in runners.items():
+                r.dead = name != mode
+            e0, t = sum(e.execTime for e in mechanics), time.perf_counter()
+            O.run(args.steps, True)
+            wall[mode] = wall.get(mode, 0.0) + time.perf_counter() - t
+            own[mode] = own.get(mode, 0.0) + sum(e.execTime for e in mechanics) - e0
+    O.timingEnabled = False
+    O.engines = [e for e in O.engines if e not in runners.values()]
+    steps = args.pairs * args.steps
+    rows = []
+    for name in runners:
+        row = {"bench": "granular", "case": "drum_reference", "runner": name, "period": 10,
+               "share_of_sums": round(1.0 - wall["dead"] / wall[name], 3),
+               "yade_engines_ms_with": round(1e-6 * own[name] / steps, 3),
+               "yade_engines_ms_without": round(1e-6 * own["dead"] / steps, 3),
+               "yade_engines_slowdown": round(own[name] / own["dead"] - 1.0, 3),
+               "load": round(os.getloadavg()[0], 2)}
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    return rows
 
 
 if __name__ == "__main__":
