@@ -237,3 +237,37 @@ def test_coincident_bonded_centres_are_a_material_error():
     g = ContactGraph([[0, 0, 0], [0, 0, 0]], [1.0, 1.0], [[0, 1]])
     with pytest.raises(MaterialError, match="coincident centres"):
         conductance(g, 1.0)
+
+
+def test_compiled_continuum_factors_are_the_numpy_ones(monkeypatch):
+    """The continuum law's factors by native/continuum_factors.cpp against the numpy form: a
+    simple-cubic lattice (the face nodes' eccentricity is exactly the threshold 0.4, so f
+    must agree there too) and a jittered random bond graph, g the same to 1e-13 relative and
+    the same eccentricity factors; coincident centres a MaterialError either way."""
+    import yade_electro.contacts as C
+    from yade_electro.conductance import make_law
+    from yade_electro.native import NativeError, continuum_factors
+    try:
+        continuum_factors(np.zeros((1, 3)), np.ones(1), np.ones(1), np.zeros((0, 2), dtype=np.int64), 0.4, 2.0)
+    except NativeError as exc:
+        pytest.skip(f"the compiled helper does not build here: {exc}")
+    law = make_law("continuum")
+    rng = np.random.default_rng(5)
+    lat = cubic_lattice((6, 5, 7), r=1e-3)
+    pos = rng.uniform(0, 0.01, (600, 3))
+    edges = np.array([(i, j) for i in range(600) for j in range(i + 1, 600)
+                      if np.linalg.norm(pos[i] - pos[j]) < 1.6e-3])
+    cloud = ContactGraph(pos, rng.uniform(0.5e-3, 0.8e-3, 600), edges)
+    for g in (lat, cloud, lat.with_positions(lat.pos + rng.normal(0, 1e-5, lat.pos.shape))):
+        monkeypatch.setattr(C, "NATIVE", True)
+        fast = law.factor(g)
+        monkeypatch.setattr(C, "NATIVE", False)
+        slow = law.factor(g)
+        assert np.allclose(fast, slow, rtol=1e-13, atol=0) and np.all(slow > 0)
+    # both kinds of eccentricity factor occur in the cloud and the lattice
+    assert len(set(np.round(eccentricity_factor(eccentricity(cloud)), 6))) == 2
+    same = ContactGraph([[0, 0, 0], [0, 0, 0]], [1.0, 1.0], [[0, 1]])
+    for native in (True, False):
+        monkeypatch.setattr(C, "NATIVE", native)
+        with pytest.raises(MaterialError, match="coincident"):
+            law.factor(same)

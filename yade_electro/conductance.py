@@ -53,7 +53,7 @@ from .contacts import native_helper
 from .errors import MaterialError
 from .graph import ContactGraph
 from .materials import edge_resistivity, positive_property
-from .surfaces import edge_transmission_surface
+from .surfaces import edge_transmission_surface, polyhedron_alpha
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
            "check_law_name", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
@@ -156,7 +156,8 @@ class ConductanceLaw:
 
 @register_conductance_law("continuum")
 class ContinuumLaw(ConductanceLaw):
-    """Paper 000 eq. 4-5: g = sqrt(S_i S_j) / l_ij on the bonds."""
+    """Paper 000 eq. 4-5: g = sqrt(S_i S_j) / l_ij on the bonds (compiled,
+    :func:`yade_electro.native.continuum_factors`, where it builds; else numpy)."""
 
     name = "continuum"
 
@@ -167,6 +168,18 @@ class ContinuumLaw(ConductanceLaw):
         edges = self._edges(graph, edges)
         if edges is not graph.edges and not np.array_equal(edges, graph.edges):
             raise ValueError("the continuum law conducts through the bonds of the graph only")
+        f = native_helper("continuum_factors")
+        if f is not None and graph.shift is None:
+            from .native import NativeError
+            try:
+                g, coincident = f(graph.pos, graph.radius, polyhedron_alpha(graph.degree) * graph.radius ** 2,
+                                  graph.edges, self.threshold, self.factor_)
+            except NativeError:
+                pass
+            else:
+                if coincident:
+                    raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+                return g
         s = edge_transmission_surface(graph, threshold=self.threshold, factor=self.factor_)
         return s / edge_lengths(graph, edges)
 

@@ -34,6 +34,10 @@ numpy form's closest-point regions in one compiled pass.
 (:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`), numpy's
 operations in one pass.
 
+``continuum_factors``: the geometric factors of the ``continuum`` law on every bond
+(:func:`continuum_factors`, used by :class:`yade_electro.conductance.ContinuumLaw`): the
+neighbours' barycentres, the eccentricity factors and sqrt(S_i S_j) / l_ij in three passes.
+
 ``soft_spheres``: the sphere-sphere forces of the jamming's overlap energy
 (:func:`soft_sphere_forces`), the same operations in the same order as the numpy form in
 :mod:`yade_electro.packing.jamming`, built without floating-point contraction, so that the
@@ -54,7 +58,8 @@ import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
-           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii"]
+           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii",
+           "continuum_factors"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -441,6 +446,33 @@ def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
     out = np.empty(e.shape[0])
     bad = f(e.shape[0], x.ctypes.data, r.ctypes.data, e.ctypes.data, None if s is None else s.ctypes.data,
             1 if model == "hertz" else 0, out.ctypes.data)
+    return out, int(bad)
+
+
+def continuum_factors(pos, radius, alpha_r2, edges, threshold: float, factor: float):
+    """g = sqrt(S_i S_j) / l_ij [m] of every bond ``edges`` (m, 2) of the ``continuum`` law,
+    S_i = ``alpha_r2``[i] / f_i with the eccentricity factor f_i of the bonds' neighbour
+    barycentres (as :func:`yade_electro.surfaces.edge_transmission_surface` over
+    :func:`yade_electro.conductance.edge_lengths` computes them with numpy), and the number
+    of bonds with coincident centres (their g is not meaningful); ``continuum_factors.cpp``.
+    Raises :class:`NativeError` when it cannot be built."""
+    import ctypes
+    i64, ptr, dbl = ctypes.c_int64, ctypes.c_void_p, ctypes.c_double
+    f = _shared_function("continuum_factors", "continuum_factors",
+                         [i64, ptr, ptr, ptr, i64, ptr, dbl, dbl, ptr, ptr, ptr, ptr], i64)
+    x = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
+    n = x.shape[0]
+    r = np.ascontiguousarray(radius, dtype=np.float64)
+    a = np.ascontiguousarray(alpha_r2, dtype=np.float64)
+    e = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
+    if r.shape != (n,) or a.shape != (n,):
+        raise ValueError("continuum_factors: sizes do not match")
+    if e.size and (e.min() < 0 or e.max() >= n):
+        raise ValueError("continuum_factors: a node index is out of range")
+    work, count, surface = np.empty((n, 3)), np.empty(n, dtype=np.int64), np.empty(n)
+    out = np.empty(e.shape[0])
+    bad = f(n, x.ctypes.data, r.ctypes.data, a.ctypes.data, e.shape[0], e.ctypes.data, float(threshold),
+            float(factor), work.ctypes.data, count.ctypes.data, surface.ctypes.data, out.ctypes.data)
     return out, int(bad)
 
 
