@@ -46,7 +46,7 @@ def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
     einsum sums the squares in another order, is amplified in a^2 = r1^2 - x^2 for small
     contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way."""
     import yade_electro.contacts as C
-    from yade_electro.conductance import contact_radius
+    from yade_electro.conductance import contact_radius, edge_lengths
     from yade_electro.errors import MaterialError
     from yade_electro.native import NativeError, contact_radii
     try:
@@ -72,6 +72,17 @@ def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
         monkeypatch.setattr(C, "NATIVE", native)
         with pytest.raises(MaterialError, match="coincident"):
             contact_radius(same)
+        with pytest.raises(MaterialError, match="coincident"):
+            edge_lengths(same, same.edges)
+    # the centre distances (native pair_lengths), of the graph's edges and of other pairs
+    g = ContactGraph(pos, rad, edges, shift=shift)
+    other = np.array([[0, 5], [7, 3], [499, 0]])
+    for graph, pairs in ((g, g.edges), (ContactGraph(pos, rad, edges), other)):
+        monkeypatch.setattr(C, "NATIVE", True)
+        fast = edge_lengths(graph, pairs)
+        monkeypatch.setattr(C, "NATIVE", False)
+        slow = edge_lengths(graph, pairs)
+        assert np.allclose(fast, slow, rtol=1e-15, atol=0)
 
 
 def test_compiled_contacts_are_the_numpy_ones(monkeypatch):

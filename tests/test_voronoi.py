@@ -76,8 +76,14 @@ def test_hops_widen_the_network_and_faces_are_reused():
     law1 = make_law("voronoi", container=box, hops=1)
     n1 = law1.network(graph)
     faces = law1.faces(graph)
-    law1.factor(graph, n1)
+    g1 = law1.factor(graph, n1)
     assert law1.faces(graph) is faces and law1.tessellations == 1       # the tessellation is made once
+    # the areas of an edge list are looked up once, even when the list comes as a new view
+    # (FactorNetwork passes one at every call): a move changes only the lengths
+    moved = graph.with_positions(graph.pos * 1.01)
+    g2 = law1.factor(moved, n1.reshape(-1, 2))
+    assert law1.area_lookups == 1
+    np.testing.assert_allclose(g2, g1 / 1.01, rtol=1e-12)
     n3 = make_law("voronoi", container=box, hops=3).network(graph)
     assert n3.shape[0] >= n1.shape[0]
     np.testing.assert_array_equal(n1, np.unique(np.sort(graph.edges, axis=1), axis=0))

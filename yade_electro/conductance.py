@@ -122,8 +122,20 @@ def make_law(law="continuum", **params) -> "ConductanceLaw":
 
 
 def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
-    """Centre-to-centre distance of node pairs [m]; MaterialError for coincident centres."""
+    """Centre-to-centre distance of node pairs [m]; MaterialError for coincident centres.
+    Compiled (:func:`yade_electro.native.pair_lengths`) where it builds, else numpy."""
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    f = native_helper("pair_lengths")
+    if f is not None and (graph.shift is None or edges is graph.edges):
+        from .native import NativeError
+        try:
+            length, zero = f(graph.pos, edges, graph.shift)
+        except NativeError:
+            pass
+        else:
+            if zero:
+                raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+            return length
     d = graph.edge_vectors(edges)
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     if np.any(length <= 0):
@@ -375,6 +387,8 @@ class VoronoiLaw(ConductanceLaw):
         self._faces = None
         self._key = None
         self.tessellations = 0
+        #: how often the faces' areas were looked up for an edge list (once per list)
+        self.area_lookups = 0
 
     def faces(self, graph: ContactGraph):
         """The kept tessellation's faces, made once per element set: on ``reference`` (ids,
@@ -404,11 +418,14 @@ class VoronoiLaw(ConductanceLaw):
     def factor(self, graph, edges=None):
         edges = self._edges(graph, edges)
         faces = self.faces(graph)
-        # the areas of one edge list are looked up once (moves change the lengths only)
-        if getattr(self, "_area_key", None) != (id(faces), id(edges)):
+        # the areas of one edge list are looked up once (moves change the lengths only); the
+        # edges come as a new view at every call, so they are compared, not their id
+        kept = getattr(self, "_area_edges", None)
+        if getattr(self, "_area_faces", None) is not faces or not (
+                edges is kept or (kept is not None and np.array_equal(edges, kept))):
             self._area_of_edges = faces.area_of(edges)
-            self._area_key = (id(faces), id(edges))
-            self._area_edges = edges                # keeps id(edges) from being reused
+            self._area_faces, self._area_edges = faces, edges
+            self.area_lookups += 1
         return self._area_of_edges / edge_lengths(graph, edges)
 
     def cell_volumes(self, graph) -> np.ndarray:

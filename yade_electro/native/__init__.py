@@ -31,8 +31,9 @@ the granular mode's facet walls (:func:`triangle_distance`, :func:`triangle_cand
 numpy form's closest-point regions in one compiled pass.
 
 ``contact_radii``: the contact radius of each sphere pair of the granular mode's Verlet list
-(:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`), numpy's
-operations in one pass.
+(:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`) and the
+centre distances of node pairs (:func:`pair_lengths`, used by
+:func:`yade_electro.conductance.edge_lengths`), numpy's operations in one pass.
 
 ``continuum_factors``: the geometric factors of the ``continuum`` law on every bond
 (:func:`continuum_factors`, used by :class:`yade_electro.conductance.ContinuumLaw`): the
@@ -58,7 +59,7 @@ import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
-           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii",
+           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii", "pair_lengths",
            "continuum_factors"]
 
 HERE = Path(__file__).resolve().parent
@@ -447,6 +448,24 @@ def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
     bad = f(e.shape[0], x.ctypes.data, r.ctypes.data, e.ctypes.data, None if s is None else s.ctypes.data,
             1 if model == "hertz" else 0, out.ctypes.data)
     return out, int(bad)
+
+
+def pair_lengths(pos, edges, shift=None):
+    """Centre distances |x_j - x_i (+ shift)| [m] of the node pairs ``edges`` (m, 2), and how
+    many are zero; ``contact_radii.cpp``. Raises :class:`NativeError` when it cannot be built."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    f = _shared_function("contact_radii", "pair_lengths", [i64, ptr, ptr, ptr, ptr], i64, flags=["-ffp-contract=off"])
+    x = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
+    e = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
+    s = None if shift is None else np.ascontiguousarray(shift, dtype=np.float64).reshape(-1, 3)
+    if s is not None and s.shape[0] != e.shape[0]:
+        raise ValueError("pair_lengths: one shift per pair")
+    if e.size and (e.min() < 0 or e.max() >= x.shape[0]):
+        raise ValueError("pair_lengths: a node index is out of range")
+    out = np.empty(e.shape[0])
+    zero = f(e.shape[0], x.ctypes.data, e.ctypes.data, None if s is None else s.ctypes.data, out.ctypes.data)
+    return out, int(zero)
 
 
 def continuum_factors(pos, radius, alpha_r2, edges, threshold: float, factor: float):

@@ -1,6 +1,7 @@
 // Contact radii of the granular mode's sphere pairs (yade_electro.conductance.contact_radius),
-// compiled: one pass over the Verlet list's pairs instead of numpy's dozen temporaries. The
-// numpy form's operations in its order, built without floating-point contraction.
+// and the centre distances of node pairs (conductance.edge_lengths), compiled: one pass over
+// the pairs instead of numpy's temporaries. The numpy form's operations in its order, built
+// without floating-point contraction.
 //
 // pos (n, 3), radius (n,), edges (m, 2) int64 row-major; shift (m, 3) or null (the periodic
 // image of node j next to node i); model 0 geometric (the lens where the spheres' surfaces
@@ -41,4 +42,24 @@ extern "C" int64_t contact_radii(int64_t m, const double* pos, const double* rad
         }
     }
     return coincident;
+}
+
+// The distance |x_j - x_i (+ shift)| of each pair; returns the number of zero distances.
+extern "C" int64_t pair_lengths(int64_t m, const double* pos, const int64_t* edges, const double* shift,
+                                double* out) {
+    int64_t zero = 0;
+    for (int64_t t = 0; t < m; ++t) {
+        const int64_t i = edges[2 * t], j = edges[2 * t + 1];
+        double d0 = pos[3 * j] - pos[3 * i];
+        double d1 = pos[3 * j + 1] - pos[3 * i + 1];
+        double d2 = pos[3 * j + 2] - pos[3 * i + 2];
+        if (shift) {
+            d0 += shift[3 * t];
+            d1 += shift[3 * t + 1];
+            d2 += shift[3 * t + 2];
+        }
+        out[t] = std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
+        if (!(out[t] > 0.0)) ++zero;
+    }
+    return zero;
 }
