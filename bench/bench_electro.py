@@ -1,7 +1,8 @@
 """Electrical benchmark on the bonded rods of the rod case (5,000 and 20,000 elements).
 
 Prints, per size: graph extraction from YADE (full read, and the cheap unchanged check),
-assembly (conductances + reduced Kirchhoff system), solve time cold (first solve, solver
+assembly (conductances + reduced Kirchhoff system), the ``continuum`` law's factors after a
+move (compiled and numpy, interleaved), solve time cold (first solve, solver
 setup included) and re-solve with an unchanged graph, for each solver, and the time of one
 YADE mechanical step on the same bonded packing. Ends with one JSON line.
 
@@ -57,6 +58,22 @@ def bench_size(n, repeat=5, seed=1):
               Electrode("bottom", graph.index_of(ids[bottom]), potential=0.0)]
         return ConductionProblem(graph.n_nodes, graph.edges, c, el, solver="direct")
     out["assembly_ms"], _ = best(assemble, repeat)
+
+    # the continuum law's factors after a move (a new graph object: nothing cached), compiled
+    # and numpy, interleaved
+    import yade_electro.contacts as contacts
+    from yade_electro.conductance import make_law
+    law = make_law("continuum")
+    times = {True: [], False: []}
+    for rep in range(4 * repeat):
+        for native in (True, False):
+            contacts.NATIVE = native
+            moved = graph.with_positions(graph.pos + 0.0, rep + 1)
+            t = time.perf_counter()
+            law.factor(moved)
+            times[native].append(time.perf_counter() - t)
+    contacts.NATIVE = True
+    out["continuum_factors_ms"], out["continuum_factors_numpy_ms"] = min(times[True]), min(times[False])
 
     c = conductance(graph, rod.RHO_304L)
     el_nodes = [Electrode("top", graph.index_of(ids[top]), potential=1.0),
