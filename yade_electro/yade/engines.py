@@ -802,7 +802,7 @@ class ElectroThermalEngine(ElectricalEngine):
         fields = {"temperature": heat.temperature, "body_id": graph.ids.astype(float)}
         sol = self.coupled.solution
         if sol is not None:
-            fields["potential"] = sol.potential
+            fields["potential"] = sol.potential[:graph.n_nodes]      # (surface electrodes' nodes follow)
         on = heat.conductance > 0
         e = net.edges[on]
         T = heat.temperature
