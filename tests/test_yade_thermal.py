@@ -52,6 +52,14 @@ if rows:
     temps = [b.state.temp for b in O.bodies]
     out.update(state_type=type(O.bodies[0].state).__name__, body_T_min=min(temps), body_T_max=max(temps),
                model_T_max=float(max(e.temperature)), potential_written=hasattr(O.bodies[0], "potential"))
+    if "error" not in out:
+        import meshio
+        files = e.write_vtk("vtk/rod")
+        parts, lines = meshio.read(files["particles"]), meshio.read(files["contacts"])
+        out.update(vtk_points=len(parts.points), vtk_lines=len(lines.cells_dict["line"]),
+                   bonds=int(np.sum(e.coupled.heat.conductance > 0)), n_bodies=len(O.bodies),
+                   vtk_T_max=float(parts.point_data["temperature"].max()),
+                   vtk_V_max=float(parts.point_data["potential"].max()))
 print(json.dumps(out))
 '''
 
@@ -73,6 +81,10 @@ def test_adiabatic_heating_writes_temperatures(run_yade_script, tmp_path, theta)
     assert out["state_type"] == "ThermalState" and out["potential_written"]
     assert out["body_T_max"] == pytest.approx(out["model_T_max"], rel=1e-12)
     assert out["body_T_min"] >= 293.15
+    # write_vtk: every body a point, every conducting bond a line, the fields of the model
+    assert out["vtk_points"] == out["n_bodies"] and out["vtk_lines"] == out["bonds"] > 0
+    assert out["vtk_T_max"] == pytest.approx(out["model_T_max"], rel=1e-12)
+    assert out["vtk_V_max"] == pytest.approx(0.1, rel=1e-9)
     rows = list(csv.DictReader(io.StringIO((tmp_path / "heat.csv").read_text())))
     assert len(rows) == 5 and float(rows[-1]["joule_energy"]) == pytest.approx(out["joule_energy"])
 
