@@ -559,8 +559,9 @@ def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
 
 @pytest.mark.parametrize("repeats", [False, True])
 def test_compiled_laplacian_fill_is_the_numpy_one(repeats, monkeypatch):
-    """ReducedSystem's compiled K_uu fill (native/laplacian_fill.cpp) gives numpy's values to
-    the last bit, with and without an extra diagonal, for distinct and repeated edges;
+    """ReducedSystem's compiled K_uu pattern and fill (native/csr_pattern.cpp,
+    laplacian_fill.cpp) give scipy's pattern and numpy's values to the last bit, with and
+    without an extra diagonal, for distinct and repeated edges;
     K_ud and K_dd are the same; without the helper it falls back to numpy."""
     from yade_electro.condensation import ReducedSystem
     import yade_electro.native as native
@@ -572,6 +573,11 @@ def test_compiled_laplacian_fill_is_the_numpy_one(repeats, monkeypatch):
         e = np.concatenate([e, e[::5]])
     groups = [np.arange(0, 7), np.arange(50, 60)]
     fast, slow = ReducedSystem(n, e, groups), ReducedSystem(n, e, groups, native=False)
+    # the compiled patterns (native/csr_pattern.cpp; repeated edges go to scipy) are scipy's
+    a, b = fast.Kuu, slow.Kuu
+    assert np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
+    assert a.indices.dtype == b.indices.dtype and a.has_sorted_indices
+    assert np.array_equal(fast.diagonal_slots, slow.diagonal_slots)
     for extra in (None, rng.random(fast.n_unknowns), 2.5):
         c = rng.random(len(e))
         fast.assemble(c, extra)

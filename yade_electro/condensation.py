@@ -27,9 +27,13 @@ import scipy.sparse as sp
 __all__ = ["ReducedSystem"]
 
 
-def _pattern(rows, cols, shape):
+def _pattern(rows, cols, shape, native: bool = False):
     """A CSR matrix (zero data) with one entry per distinct (row, col) and, for every input
     pair, the index of its entry in ``data``; and whether the pairs were all distinct.
+
+    ``native``: distinct pairs by the compiled helper
+    (:func:`yade_electro.native.csr_pattern`, the same pattern and slots in one call) where it
+    builds; repeated pairs, or no helper, go the ways below.
 
     Distinct pairs (the usual case: an edge list without repeats) go through scipy's COO to
     CSR conversion, a counting sort by row and a sort within each row, both in C, carrying
@@ -39,6 +43,17 @@ def _pattern(rows, cols, shape):
     nr, nc = shape
     rows = np.asarray(rows)
     N = rows.size
+    if native and N:
+        from .native import NativeError, csr_pattern
+        try:
+            got = csr_pattern(rows, cols, shape)
+        except NativeError:
+            got = None
+        if got is not None:
+            indptr, indices, slot = got
+            M = sp.csr_matrix((np.zeros(N), indices, indptr), shape=shape)
+            M.has_sorted_indices = True
+            return M, slot, True
     if 0 < N < 2 ** 53:
         M = sp.csr_matrix((np.arange(N, dtype=float), (rows, cols)), shape=shape)   # sums repeats
         if M.nnz == N:
@@ -61,6 +76,8 @@ def _small_index(a, bound):
 
 def _map(slots, edge, sign, nnz, m):
     """Sparse (nnz x m) matrix taking edge values to CSR data."""
+    if len(slots) == 0:                 # (no group: scipy's COO conversion would cost 0.4 ms)
+        return sp.csr_matrix((nnz, m))
     return sp.csr_matrix((sign, (slots, edge)), shape=(nnz, m))
 
 
@@ -76,6 +93,10 @@ class ReducedSystem:
         of ``K_ud``).
     exclude : (n,) bool array, optional
         Nodes left out (they must not share an edge of non-zero value with kept nodes).
+    native : bool
+        Use the compiled helpers where they build (default): the patterns of ``K_uu`` and of
+        the incidence matrix (:func:`yade_electro.native.csr_pattern`) and the fill of
+        ``K_uu`` (:func:`yade_electro.native.laplacian_fill`); False: scipy and numpy only.
 
     Attributes
     ----------
@@ -123,7 +144,7 @@ class ReducedSystem:
         # a scatter, and the unknowns' incidence matrix for the diagonal
         rows = np.concatenate([ui[uu], uj[uu], np.arange(nu)])
         cols = np.concatenate([uj[uu], ui[uu], np.arange(nu)])
-        self.Kuu, slot, self._uu_distinct = _pattern(rows, cols, (nu, nu))
+        self.Kuu, slot, self._uu_distinct = _pattern(rows, cols, (nu, nu), native)
         del rows, cols
         nuu = int(uu.sum())
         nnz = self.Kuu.nnz
@@ -133,9 +154,13 @@ class ReducedSystem:
         del slot
         # the diagonal: the unknowns' incidence matrix (nu x m, ones), a CSR mat-vec
         inc_rows = np.concatenate([ui[uu], uj[uu], ui[ud_i], uj[ud_j]])
-        self._incidence = sp.csr_matrix((np.ones(inc_rows.size), (inc_rows, np.concatenate(
-            [eid[uu], eid[uu], eid[ud_i], eid[ud_j]]))), shape=(nu, m))
-        del inc_rows
+        inc_cols = np.concatenate([eid[uu], eid[uu], eid[ud_i], eid[ud_j]])
+        if native and inc_rows.size:            # (the pairs are distinct: an edge meets a row once)
+            self._incidence, _, _ = _pattern(inc_rows, inc_cols, (nu, m), native)
+            self._incidence.data[:] = 1.0
+        else:
+            self._incidence = sp.csr_matrix((np.ones(inc_rows.size), (inc_rows, inc_cols)), shape=(nu, m))
+        del inc_rows, inc_cols
 
         # K_ud: -c between an unknown and a group
         rows = np.concatenate([ui[ud_i], uj[ud_j]])
@@ -159,7 +184,7 @@ class ReducedSystem:
         self._Kdu_from_ud = self._Kdu_pattern.data.astype(np.int64) - 1
         self._Kdu = None
         self._assembled = False
-        self._native = bool(native)     # K_uu filled by the compiled pass when it builds
+        self._native = bool(native)     # K_uu filled by the compiled pass when it builds (its pattern too)
         self.compiled = None            # how the last assembly went (None: numpy asked for, or none yet)
 
     # -- values ------------------------------------------------------------------------------

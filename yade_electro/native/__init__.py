@@ -39,6 +39,11 @@ centre distances of node pairs (:func:`pair_lengths`, used by
 (:func:`continuum_factors`, used by :class:`yade_electro.conductance.ContinuumLaw`): the
 neighbours' barycentres, the eccentricity factors and sqrt(S_i S_j) / l_ij in three passes.
 
+``csr_pattern``: a CSR sparsity pattern from (row, col) pairs with each pair's slot in the
+data (:func:`csr_pattern`, used by :class:`yade_electro.condensation.ReducedSystem` for the
+Laplacian's pattern and the incidence matrix): scipy's COO -> CSR conversion and index sort
+in one call, the same pattern.
+
 ``soft_spheres``: the sphere-sphere forces of the jamming's overlap energy
 (:func:`soft_sphere_forces`), the same operations in the same order as the numpy form in
 :mod:`yade_electro.packing.jamming`, built without floating-point contraction, so that the
@@ -60,7 +65,7 @@ import numpy as np
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
            "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii", "pair_lengths",
-           "continuum_factors"]
+           "continuum_factors", "csr_pattern"]
 
 HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
@@ -493,6 +498,27 @@ def continuum_factors(pos, radius, alpha_r2, edges, threshold: float, factor: fl
     bad = f(n, x.ctypes.data, r.ctypes.data, a.ctypes.data, e.shape[0], e.ctypes.data, float(threshold),
             float(factor), work.ctypes.data, count.ctypes.data, surface.ctypes.data, out.ctypes.data)
     return out, int(bad)
+
+
+def csr_pattern(rows, cols, shape):
+    """(indptr, indices) int32 of the CSR pattern of the (row, col) pairs, columns sorted in
+    each row, and ``slot`` (N,) int64: the position of each pair in the data; None when a
+    pair repeats or the sizes need 64-bit indices (the caller then uses scipy);
+    ``csr_pattern.cpp``. Raises :class:`NativeError` when it cannot be built."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    f = _shared_function("csr_pattern", "csr_pattern", [i64, i64, ptr, ptr, ptr, ptr, ptr], i64)
+    r = np.ascontiguousarray(rows, dtype=np.int64)
+    c = np.ascontiguousarray(cols, dtype=np.int64)
+    nr, nc = (int(v) for v in shape)
+    N = r.size
+    if c.size != N or N >= 2 ** 31 - 1 or nc >= 2 ** 31 - 1:
+        return None
+    if N and (r.min() < 0 or r.max() >= nr or c.min() < 0 or c.max() >= nc):
+        raise ValueError("csr_pattern: a row or column index is out of range")
+    indptr, indices, slot = np.empty(nr + 1, np.int32), np.empty(N, np.int32), np.empty(N, np.int64)
+    m = f(nr, N, r.ctypes.data, c.ctypes.data, indptr.ctypes.data, indices.ctypes.data, slot.ctypes.data)
+    return None if m < 0 else (indptr, indices, slot)
 
 
 EIGEN_INCLUDE = "/usr/include/eigen3"
