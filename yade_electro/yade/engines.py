@@ -780,13 +780,17 @@ class ElectroThermalEngine(ElectricalEngine):
     def contact_heat_flow(self):
         """Per contact: (body id pairs (m, 2), conductance G [W/K], heat flow [W] from the
         first body to the second) of the contacts that conduct now."""
-        net, heat = self.coupled.network, self.coupled.heat
-        G = heat.conductance
-        on = G > 0
-        e = net.edges[on]
-        T = heat.temperature
+        e, G, q = self._conducting_contacts()
         ids = self.body_ids
-        return np.column_stack([ids[e[:, 0]], ids[e[:, 1]]]), G[on], G[on] * (T[e[:, 0]] - T[e[:, 1]])
+        return np.column_stack([ids[e[:, 0]], ids[e[:, 1]]]), G, q
+
+    def _conducting_contacts(self):
+        """(node pairs (m, 2), G [W/K], heat flow [W] from the first node to the second) of the
+        edges that conduct now."""
+        heat = self.coupled.heat
+        on = heat.conductance > 0
+        e, G, T = self.coupled.network.edges[on], heat.conductance[on], heat.temperature
+        return e, G, G * (T[e[:, 0]] - T[e[:, 1]])
 
     def write_vtk(self, prefix: str) -> Dict[str, str]:
         """Write the last call's state for ParaView (meshio, ``.vtu``): ``<prefix>_particles.vtu``
@@ -798,22 +802,18 @@ class ElectroThermalEngine(ElectricalEngine):
         from ..vtk import write_bonds, write_elements
         if self.coupled.heat is None:
             raise RuntimeError(f"engine {self.label!r} has not run yet: call O.run (or engine.step()) first")
-        graph, net, heat = self.coupled.network.graph, self.coupled.network, self.coupled.heat
-        fields = {"temperature": heat.temperature, "body_id": graph.ids.astype(float)}
+        graph = self.coupled.network.graph
+        fields = {"temperature": self.coupled.heat.temperature, "body_id": graph.ids.astype(float)}
         sol = self.coupled.solution
         if sol is not None:
             fields["potential"] = sol.potential[:graph.n_nodes]      # (surface electrodes' nodes follow)
-        on = heat.conductance > 0
-        e = net.edges[on]
-        T = heat.temperature
-        out = {"particles": write_elements(f"{prefix}_particles.vtu", graph.pos, graph.radius, fields),
-               "contacts": write_bonds(f"{prefix}_contacts.vtu", graph.pos, e,
-                                       {"conductance_W_per_K": heat.conductance[on],
-                                        "heat_flow_W": heat.conductance[on] * (T[e[:, 0]] - T[e[:, 1]]),
-                                        "id1": graph.ids[e[:, 0]].astype(float),
-                                        "id2": graph.ids[e[:, 1]].astype(float)},
-                                       vectors=graph.edge_vectors(e) if graph.shift is not None else None)}
-        return out
+        e, G, q = self._conducting_contacts()
+        return {"particles": write_elements(f"{prefix}_particles.vtu", graph.pos, graph.radius, fields),
+                "contacts": write_bonds(f"{prefix}_contacts.vtu", graph.pos, e,
+                                        {"conductance_W_per_K": G, "heat_flow_W": q,
+                                         "id1": graph.ids[e[:, 0]].astype(float),
+                                         "id2": graph.ids[e[:, 1]].astype(float)},
+                                        vectors=graph.edge_vectors(e) if graph.shift is not None else None)}
 
     def _initial_temperatures(self, table, default):
         """A function graph -> starting temperatures from ``{body id: K}`` (checked now)."""
