@@ -155,11 +155,8 @@ class ReducedSystem:
         # the diagonal: the unknowns' incidence matrix (nu x m, ones), a CSR mat-vec
         inc_rows = np.concatenate([ui[uu], uj[uu], ui[ud_i], uj[ud_j]])
         inc_cols = np.concatenate([eid[uu], eid[uu], eid[ud_i], eid[ud_j]])
-        if native and inc_rows.size:            # (the pairs are distinct: an edge meets a row once)
-            self._incidence, _, _ = _pattern(inc_rows, inc_cols, (nu, m), native)
-            self._incidence.data[:] = 1.0
-        else:
-            self._incidence = sp.csr_matrix((np.ones(inc_rows.size), (inc_rows, inc_cols)), shape=(nu, m))
+        self._incidence, _, _ = _pattern(inc_rows, inc_cols, (nu, m), native)   # distinct: an edge meets a row once
+        self._incidence.data[:] = 1.0
         del inc_rows, inc_cols
 
         # K_ud: -c between an unknown and a group
