@@ -95,7 +95,18 @@ def test_a_particle_leaving_the_bed(run_yade_script, tmp_path):
     assert out["heat"] - out["heat_init"] == pytest.approx(out["wall_heat"] + out["particle_heat"], rel=1e-9)
 
 
-BAD = r'''
+OUTCOME = r'''
+def outcome(make):
+    """'accepted', or 'ExceptionType: message' of what make() raised."""
+    try:
+        make()
+        return "accepted"
+    except Exception as exc:
+        return f"{type(exc).__name__}: {exc}"
+'''
+
+
+BAD = OUTCOME + r'''
 import json
 from yade import pack, utils
 from yade_electro.yade import HeatEngine
@@ -113,20 +124,13 @@ cases = {
     "bad_skin": dict(bonds="contacts", skin=-1.0),
 }
 for name, kw in cases.items():
-    try:
-        HeatEngine(8900, 172, 385, 273.15, label="bad_" + name, **kw)
-        out[name] = "accepted"
-    except Exception as exc:
-        out[name] = f"{type(exc).__name__}: {exc}"
+    out[name] = outcome(lambda: HeatEngine(8900, 172, 385, 273.15, label="bad_" + name, **kw))
 from yade_electro.yade import ElectricalEngine
 for name, kw in {"wall_electrode_no_contact": dict(bonds="contacts"),
                  "wall_electrode_bonded": dict(bonds="cohesive", law="continuum")}.items():
-    try:
-        ElectricalEngine(1e-7, {"plate": dict(wall=floor, potential=0.0), "top": dict(select=[s[1]], potential=1.0)},
-                         label="bad_" + name, **kw)
-        out[name] = "accepted"
-    except Exception as exc:
-        out[name] = f"{type(exc).__name__}: {exc}"
+    out[name] = outcome(lambda: ElectricalEngine(1e-7, {"plate": dict(wall=floor, potential=0.0),
+                                                        "top": dict(select=[s[1]], potential=1.0)},
+                                                 label="bad_" + name, **kw))
 print(json.dumps(out))
 '''
 
@@ -144,7 +148,7 @@ def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path
     assert "granular mode only" in out["wall_electrode_bonded"]
 
 
-PERIODIC = r"""
+PERIODIC = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
@@ -213,11 +217,7 @@ for name, make in {
         "heat_walls": lambda: HeatEngine(7850, 470, 50, T0, bonds="contacts", label="h2",
                                          walls={"w": dict(bodies=[O.bodies.append(utils.wall(0, axis=2))],
                                                           temperature=T0)})}.items():
-    try:
-        make()
-        out[name] = "accepted"
-    except Exception as exc:
-        out[name] = f"{type(exc).__name__}: {exc}"
+    out[name] = outcome(make)
 print(json.dumps(out))
 """
 
@@ -318,19 +318,28 @@ def figures(e):
 '''
 
 
-def test_granular_save_and_load_continues(run_yade_script, tmp_path):
+def saved_and_continued(run_yade_script, tmp_path, scene, before, after, between=""):
+    """The figures of ``scene`` (``build()`` and ``figures(e)``, engine labelled 'heat') run
+    ``before`` steps, then ``between`` (script lines), then ``after`` steps: uninterrupted, and
+    saved after ``between`` then loaded in a new process, re-attached and continued. Returns
+    (uninterrupted, continued, their temperatures by sorted body id)."""
     import numpy as np
     ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
     ref_dir.mkdir(), run_dir.mkdir()
-    ref = run_yade_script(SAVED_BED + "e = build()\nO.run(2000, True)\nprint(json.dumps(figures(e)))\n",
+    start = f"e = build()\nO.run({before}, True)\n" + between
+    ref = run_yade_script(scene + start + f"O.run({after}, True)\nprint(json.dumps(figures(e)))\n",
                           cwd=ref_dir, check=True).result
-    run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\nO.save('bed.yade.gz')\nprint('{}')\n",
-                    cwd=run_dir, check=True)
-    out = run_yade_script(SAVED_BED + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(1000, True)\n"
+    run_yade_script(scene + start + "O.save('bed.yade.gz')\nprint('{}')\n", cwd=run_dir, check=True)
+    out = run_yade_script(scene + f"O.load('bed.yade.gz')\ne = attach('heat')\nO.run({after}, True)\n"
                           "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
+    keys = sorted(ref["T"])
+    return ref, out, np.array([ref["T"][k] for k in keys]), np.array([out["T"][k] for k in keys])
+
+
+def test_granular_save_and_load_continues(run_yade_script, tmp_path):
+    import numpy as np
+    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, SAVED_BED, 1000, 1000)
     assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
-    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
-    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
     assert out["wall_heat"] == pytest.approx(ref["wall_heat"], rel=1e-9) and ref["wall_heat"] > 0
     assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)
@@ -340,23 +349,14 @@ def test_temperatures_set_before_a_save_are_kept(run_yade_script, tmp_path):
     # set_temperatures, then O.save before the engine's next call: the run loaded in a new
     # process applies them at its first call, as the uninterrupted run does
     import numpy as np
-    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
-    ref_dir.mkdir(), run_dir.mkdir()
     hot = "e.set_temperatures({int(e.body_ids[0]): 500.0, int(e.body_ids[-1]): 450.0})\n"
-    ref = run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\n" + hot + "O.run(1000, True)\n"
-                          "print(json.dumps(figures(e)))\n", cwd=ref_dir, check=True).result
-    run_yade_script(SAVED_BED + "e = build()\nO.run(1000, True)\n" + hot + "O.save('bed.yade.gz')\nprint('{}')\n",
-                    cwd=run_dir, check=True)
-    out = run_yade_script(SAVED_BED + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(1000, True)\n"
-                          "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
-    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
-    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
+    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, SAVED_BED, 1000, 1000, between=hot)
     assert np.max(ta) > 380.0                                 # the 500 K particle is still hot
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
     assert out["heat"] == pytest.approx(ref["heat"], rel=1e-9)
 
 
-MATERIALS = r"""
+MATERIALS = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
@@ -394,11 +394,8 @@ bad = {"label": {"glass": dict(conductivity=1.0)}, "index": {7: dict(conductivit
        "property": {"cu": dict(emissivity=0.5)}, "negative": {"cu": dict(conductivity=-1.0)},
        "resistivity_heat_only": {"cu": dict(resistivity=1e-6)}, "not_a_dict": ["cu"]}
 for name, m in bad.items():
-    try:
-        HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact", label="bad_" + name, materials=m)
-        out[name] = "accepted"
-    except Exception as exc:
-        out[name] = f"{type(exc).__name__}: {exc}"
+    out[name] = outcome(lambda: HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact",
+                                           label="bad_" + name, materials=m))
 print(json.dumps(out))
 """
 
@@ -455,23 +452,13 @@ def figures(e):
 
 def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path):
     import numpy as np
-    ref_dir, run_dir = tmp_path / "ref", tmp_path / "run"
-    ref_dir.mkdir()
-    run_dir.mkdir()
-    ref = run_yade_script(SAVED_PERIODIC + "e = build()\nO.run(200, True)\nprint(json.dumps(figures(e)))\n",
-                          cwd=ref_dir, check=True).result
-    run_yade_script(SAVED_PERIODIC + "e = build()\nO.run(100, True)\nO.save('bed.yade.gz')\nprint('{}')\n",
-                    cwd=run_dir, check=True)
-    out = run_yade_script(SAVED_PERIODIC + "O.load('bed.yade.gz')\ne = attach('heat')\nO.run(100, True)\n"
-                          "print(json.dumps(figures(e)))\n", cwd=run_dir, check=True).result
+    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, SAVED_PERIODIC, 100, 100)
     assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
-    ta = np.array([ref["T"][k] for k in sorted(ref["T"])])
-    tb = np.array([out["T"][k] for k in sorted(ref["T"])])
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 300.0))
     assert abs(ref["heat"]) < 1e-9 * 10.0 * 125 * 8900 * 172 * 4 / 3 * np.pi * 0.00201 ** 3   # a cosine: no net heat
 
 
-POURED = r"""
+POURED = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
@@ -499,11 +486,7 @@ out["heat_end"] = e.history.rows[-1]["heat_content"]
 out["particle_heat_end"] = e.history.rows[-1]["particle_heat"]
 errors = {}
 for name, t in {"wall": {wall: 300.0}, "missing": {99: 300.0}, "nan": {a: float("nan")}, "list": [a]}.items():
-    try:
-        e.set_temperatures(t)
-        errors[name] = "accepted"
-    except Exception as exc:
-        errors[name] = f"{type(exc).__name__}: {exc}"
+    errors[name] = outcome(lambda: e.set_temperatures(t))
 out["errors"] = errors
 print(json.dumps(out))
 """
