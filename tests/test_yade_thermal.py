@@ -128,3 +128,38 @@ def test_boundary_conditions_selected_by_predicates(run_yade_script, tmp_path):
     assert out["heat"] == pytest.approx(out["joule"] - out["absorbed"] + out["boundary"] + out["convection"]
                                         + out["flux"], rel=1e-9)
     assert out["convection"] < 0 and out["boundary"] < 0 and out["absorbed"] > 0 and out["flux"] == 0
+
+
+STATE_REPLACED = SCENE + r'''
+e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.1), "bottom": dict(select=BOTTOM, potential=0.0)},
+                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
+                         thermal_dt=1e-3, iterPeriod=1)
+O.engines = O.engines + [e.runner]
+O.run(3, True)
+w = e._temperature_writer
+refreshes = w.refreshes
+k = e.body_ids.tolist().index(len(O.bodies) // 2)
+b = O.bodies[int(e.body_ids[k])]
+st = State()                    # a plain State: no temp of YADE's
+st.pos, st.mass, st.inertia, st.blockedDOFs = b.state.pos, b.state.mass, b.state.inertia, b.state.blockedDOFs
+b.state = st
+calls = 0
+while calls < 20 and not (isinstance(b.state, ThermalState) and b.state.temp == float(e.temperature[k])):
+    O.run(1, True)
+    calls += 1
+out = dict(calls=calls, thermal=isinstance(b.state, ThermalState), temp=b.state.temp if isinstance(b.state, ThermalState) else None,
+           model=float(e.temperature[k]), sweep=w.sweep_calls, refreshes=w.refreshes - refreshes, replaced=w.replaced_states,
+           others=max(abs(x.state.temp - t) for x, t in zip(e.reader.bodies, e.temperature.tolist())))
+print(json.dumps(out))
+'''
+
+
+def test_a_state_replaced_by_the_script_gets_the_temperatures(run_yade_script, tmp_path):
+    """The engine keeps the bodies' State handles between calls (TemperatureWriter); a state a
+    script replaces, here by a plain State without YADE's temp, is found by the sweep within
+    sweep_calls calls, made a ThermalState and given the model's temperature."""
+    out = run_yade_script(STATE_REPLACED, timeout=120, cwd=tmp_path, check=True).result
+    assert out["thermal"] and out["temp"] == out["model"] > 293.15
+    assert 1 <= out["calls"] <= out["sweep"]
+    assert out["refreshes"] == 1 and out["replaced"] == 1
+    assert out["others"] == 0.0

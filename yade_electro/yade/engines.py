@@ -47,9 +47,9 @@ from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource, Therma
 from . import persistence, registry
 from .runtime import import_yade
 from .granular import GranularReader, check_wall_bodies
-from .scene import SceneReader, check_write_back, predicate_selector, write_body_attribute
+from .scene import SceneReader, TemperatureWriter, check_write_back, predicate_selector, write_body_attribute
 
-__all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ensure_thermal_state", "engine_class"]
+__all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "engine_class"]
 
 log = logging.getLogger(__name__)
 
@@ -572,21 +572,6 @@ class ElectricalEngine(_Engine):
         return dict(self.solution.electrode_current)
 
 
-def ensure_thermal_state(bodies) -> int:
-    """Give every body a ``ThermalState`` (YADE's state with ``temp``), carrying over all the
-    attributes of its current state (position, velocity, mass, blocked DOFs...). Returns how
-    many states were replaced."""
-    yade = import_yade()
-    replaced = 0
-    for b in bodies:
-        if not isinstance(b.state, yade.ThermalState):
-            ts = yade.ThermalState()
-            ts.updateAttrs(b.state.dict())
-            b.state = ts
-            replaced += 1
-    return replaced
-
-
 # =========================================================================================
 class ElectroThermalEngine(ElectricalEngine):
     """Joule heating and heat conduction every ``iterPeriod`` steps of a YADE simulation.
@@ -730,7 +715,7 @@ class ElectroThermalEngine(ElectricalEngine):
                                            sources=heat_sources, thermal_solver=thermal_solver,
                                            walls=[w for w, _ in wall_specs], **extra)
         self._last_time = float(self.O.time)
-        self._states_checked = -1
+        self._temperature_writer = TemperatureWriter()
         if initial_temperature is not None and _resume is None:
             self.coupled.restore_temperatures(self._initial_temperatures(initial_temperature, temperature))
         if _resume is not None:
@@ -929,10 +914,7 @@ class ElectroThermalEngine(ElectricalEngine):
             row = self.coupled.step(graph, dt)
         self._last_time = float(self.O.time)
         bodies = self.reader.bodies
-        if self._states_checked != self.reader.full_reads:    # the body set changes only there
-            ensure_thermal_state(bodies)
-            self._states_checked = self.reader.full_reads
-        write_body_attribute(bodies, "state.temp", self.coupled.temperature)
+        self._temperature_writer.write(bodies, self.coupled.temperature)
         sol = self.coupled.solution
         if self.write_back and sol is not None and sol is not self._written:
             write_body_attribute(bodies, self.write_back, sol.potential)

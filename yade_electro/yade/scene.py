@@ -63,7 +63,7 @@ from ..errors import GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "write_body_attribute", "predicate_selector", "check_write_back",
+__all__ = ["SceneReader", "write_body_attribute", "TemperatureWriter", "ensure_thermal_state", "predicate_selector", "check_write_back",
            "BOND_CHECKS", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced", "warn_left_out",
            "PERIODIC_REFUSAL"]
 
@@ -442,6 +442,71 @@ def write_body_attribute(bodies, name: str, values) -> None:
     owner, _, attr = name.rpartition(".")
     targets = map(operator.attrgetter(owner), bodies) if owner else bodies
     deque(map(setattr, targets, repeat(attr), np.asarray(values, dtype=float).tolist()), maxlen=0)
+
+
+def ensure_thermal_state(bodies) -> int:
+    """Give every body a ``ThermalState`` (YADE's state with ``temp``), carrying over all the
+    attributes of its current state (position, velocity, mass, blocked DOFs...). Returns how
+    many states were replaced. (A plain ``State`` has no ``temp``: setting one there makes a
+    Python attribute that YADE neither saves nor shows.)"""
+    yade = import_yade()
+    replaced = 0
+    for b in bodies:
+        if not isinstance(b.state, yade.ThermalState):
+            ts = yade.ThermalState()
+            ts.updateAttrs(b.state.dict())
+            b.state = ts
+            replaced += 1
+    return replaced
+
+
+class TemperatureWriter:
+    """Writes temperatures [K] to ``b.state.temp`` of a list of bodies through their State
+    handles, kept between calls.
+
+    Taking ``b.state`` of every body at every call cost more than the writes themselves:
+    measured on the drum's 2,038 spheres in one process, 0.53 ms a call with the handles
+    taken afresh against 0.19 ms with kept ones. The handles are taken again (and every
+    state made a ``ThermalState``) whenever ``bodies`` is another list (the reader's full
+    read: bodies added or erased, a new scene). A script may also give a body a new state
+    (``b.state = ...``) between calls: each call compares 1/``sweep_calls`` of the kept
+    handles with the bodies' states (YADE's ``==``, a pointer comparison), in turn, so such a
+    state gets the temperatures within ``sweep_calls`` calls (default 8; 1 checks every
+    body at every call), made a ``ThermalState`` first if it is not one.
+
+    Attributes: ``refreshes`` (how many times the handles were taken), ``replaced_states``
+    (states found replaced by a script)."""
+
+    def __init__(self, sweep_calls: int = 8):
+        if isinstance(sweep_calls, bool) or not isinstance(sweep_calls, int) or sweep_calls < 1:
+            raise ValueError(f"sweep_calls must be an integer >= 1, got {sweep_calls!r}")
+        self.sweep_calls = sweep_calls
+        self.refreshes = self.replaced_states = 0
+        self._bodies = None
+        self._states: List = []
+        self._next = 0
+
+    def write(self, bodies, values) -> None:
+        """Set ``b.state.temp = value`` for each body, in order (``values`` [K], one per body)."""
+        if bodies is not self._bodies or len(self._states) != len(bodies):
+            self._refresh(bodies)
+        elif bodies:
+            n = len(bodies)
+            chunk = -(-n // self.sweep_calls)
+            lo, hi = self._next, min(self._next + chunk, n)
+            self._next = 0 if hi >= n else hi
+            now = map(operator.attrgetter("state"), bodies[lo:hi])
+            if not all(map(operator.eq, now, self._states[lo:hi])):
+                self.replaced_states += sum(1 for b, s in zip(bodies, self._states) if b.state != s)
+                self._refresh(bodies)
+        deque(map(setattr, self._states, repeat("temp"), np.asarray(values, dtype=float).tolist()), maxlen=0)
+
+    def _refresh(self, bodies) -> None:
+        ensure_thermal_state(bodies)
+        self._bodies = bodies
+        self._states = [b.state for b in bodies]
+        self._next = 0
+        self.refreshes += 1
 
 
 def predicate_selector(predicate, whole: bool = False):
