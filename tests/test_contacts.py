@@ -135,6 +135,27 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     assert np.array_equal(C.candidate_pairs(far, np.append(r, 2e-3), 1e-3), ref_p)
 
 
+def test_facet_vertices_compiled_numpy_and_scipy_rotation_agree(monkeypatch):
+    """The facets' world vertices from their poses: the compiled pass, the numpy form and
+    scipy's Rotation (a reference we did not write) on random unit quaternions."""
+    from scipy.spatial.transform import Rotation
+    import yade_electro.contacts as C
+    rng = np.random.default_rng(11)
+    k = 500
+    q = rng.normal(size=(k, 4))
+    q /= np.linalg.norm(q, axis=1)[:, None]
+    pos = rng.uniform(-0.1, 0.1, (k, 3))
+    local = rng.uniform(-0.01, 0.01, (k, 3, 3))
+    fast = C.facet_vertices(pos, q, local)
+    monkeypatch.setattr(C, "NATIVE", False)
+    slow = C.facet_vertices(pos, q, local)
+    ref = pos[:, None, :] + np.stack([Rotation.from_quat(q).apply(local[:, v]) for v in range(3)], axis=1)
+    assert fast.shape == (k, 3, 3)
+    assert np.abs(fast - slow).max() <= 4e-17, np.abs(fast - slow).max()      # a few ulps of 0.1 m
+    assert np.abs(slow - ref).max() <= 1e-16, np.abs(slow - ref).max()
+    assert np.abs(C.quaternion_matrices(q) - Rotation.from_quat(q).as_matrix()).max() <= 2e-15   # 1.1e-15 found
+
+
 def test_plane_box_and_triangle_overlaps():
     r = 1e-3
     pos = np.array([[0, 0, 0.9e-3], [0, 0, -0.5e-3], [0, 0, 2e-3]])

@@ -28,7 +28,8 @@ at 20,000 (2026-12-03).
 
 ``wall_contacts``: sphere-triangle distances and the candidate (sphere, triangle) pairs of
 the granular mode's facet walls (:func:`triangle_distance`, :func:`triangle_candidates`), the
-numpy form's closest-point regions in one compiled pass.
+numpy form's closest-point regions in one compiled pass; and the facets' world vertices from
+their poses (:func:`facet_vertices`).
 
 ``contact_radii``: the contact radius of each sphere pair of the granular mode's Verlet list
 (:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`) and the
@@ -64,7 +65,7 @@ import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
-           "laplacian_fill", "triangle_distance", "triangle_candidates", "contact_radii", "pair_lengths",
+           "laplacian_fill", "triangle_distance", "triangle_candidates", "facet_vertices", "contact_radii", "pair_lengths",
            "continuum_factors", "csr_pattern"]
 
 HERE = Path(__file__).resolve().parent
@@ -428,6 +429,25 @@ def triangle_candidates(pos, radius, skin: float, triangles, centre, reach):
         if m <= room:
             return spheres[:m].copy(), pieces[:m].copy()
         room = m
+
+
+def facet_vertices(pos, quat, local) -> np.ndarray:
+    """World vertices (k, 3, 3) [m] of k rigid triangles from their positions (k, 3), unit
+    quaternions (k, 4) stored (x, y, z, w) and vertices in the body frame (k, 3, 3), as
+    :func:`yade_electro.contacts.facet_vertices` computes them with numpy;
+    ``wall_contacts.cpp``. Raises :class:`NativeError` when it cannot be built."""
+    import ctypes
+    i64, ptr = ctypes.c_int64, ctypes.c_void_p
+    f = _wall_function("wall_facet_vertices", [i64, ptr, ptr, ptr, ptr], None)
+    p = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
+    q = np.ascontiguousarray(quat, dtype=np.float64).reshape(-1, 4)
+    loc = np.ascontiguousarray(local, dtype=np.float64).reshape(-1, 3, 3)
+    if not (p.shape[0] == q.shape[0] == loc.shape[0]):
+        raise ValueError(f"facet_vertices: {p.shape[0]} positions, {q.shape[0]} quaternions, {loc.shape[0]} "
+                         "triangles")
+    out = np.empty_like(loc)
+    f(p.shape[0], p.ctypes.data, q.ctypes.data, loc.ctypes.data, out.ctypes.data)
+    return out
 
 
 def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):

@@ -86,3 +86,24 @@ extern "C" int64_t wall_triangle_candidates(int64_t n, const double* pos, const 
     }
     return m;
 }
+
+// World vertices of k rigid triangles (YADE facets): out[t, v] = pos[t] + R(quat[t]) local[t, v],
+// R the rotation matrix of the unit quaternion (x, y, z, w) as contacts.quaternion_matrices
+// writes it, the products summed over j = 0, 1, 2 in turn. pos (k, 3), quat (k, 4), local and
+// out (k, 3, 3).
+extern "C" void wall_facet_vertices(int64_t k, const double* pos, const double* quat, const double* local,
+                                    double* out) {
+    for (int64_t t = 0; t < k; ++t) {
+        const double x = quat[4 * t], y = quat[4 * t + 1], z = quat[4 * t + 2], w = quat[4 * t + 3];
+        const double R[3][3] = {
+            {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+            {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+            {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+        const double* p = pos + 3 * t;
+        for (int v = 0; v < 3; ++v) {
+            const double* l = local + 9 * t + 3 * v;
+            double* o = out + 9 * t + 3 * v;
+            for (int i = 0; i < 3; ++i) o[i] = p[i] + (R[i][0] * l[0] + R[i][1] * l[1] + R[i][2] * l[2]);
+        }
+    }
+}

@@ -41,8 +41,8 @@ from typing import Dict, List, Optional
 
 import numpy as np
 
-from ..contacts import (WallGeometry, candidate_pairs, max_displacement, periodic_candidate_pairs, wall_candidates,
-                        wall_overlaps)
+from ..contacts import (WallGeometry, candidate_pairs, facet_vertices, max_displacement, periodic_candidate_pairs,
+                        quaternion_matrices, wall_candidates, wall_overlaps)
 from ..errors import BoundaryConditionError, GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
@@ -87,18 +87,7 @@ def check_wall_bodies(O, name, ids):
 
 def _rotation(q):
     """Rotation matrix of a YADE Quaternion."""
-    return _rotations(np.array([[q[0], q[1], q[2], q[3]]]))[0]
-
-
-def _rotations(q):
-    """Rotation matrices (k, 3, 3) of unit quaternions (k, 4) stored (x, y, z, w), as YADE's
-    ``Quaternion[i]`` gives them."""
-    x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    R = np.empty((q.shape[0], 3, 3))
-    R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = 1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)
-    R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = 2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)
-    R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = 2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)
-    return R
+    return quaternion_matrices(np.array([[q[0], q[1], q[2], q[3]]]))[0]
 
 
 class _WallReader:
@@ -133,9 +122,7 @@ class _WallReader:
         else:
             pos = np.array([tuple(st.pos) for st in states], dtype=float)
         quat = np.array([(q[0], q[1], q[2], q[3]) for q in map(attrgetter("ori"), states)], dtype=float)
-        R = _rotations(quat)
-        verts = pos[:, None, :] + np.einsum("kij,kvj->kvi", R, self._local)
-        return WallGeometry("triangles", vertices=verts)
+        return WallGeometry("triangles", vertices=facet_vertices(pos, quat, self._local))
 
 
 class GranularReader:
