@@ -298,12 +298,14 @@ class ElectroThermalModel:
         self._wall_contacts[name] = new
         self._walls_applied = None
 
-    def wall_conductances(self, graph: ContactGraph) -> dict:
+    def wall_conductances(self, graph: ContactGraph, names=None) -> dict:
         """name -> (nodes, G [W/K]) of each wall's contacts on ``graph`` (adiabatic walls too:
-        what they would conduct)."""
+        what they would conduct), or of the walls ``names`` only."""
         lam = np.asarray(self.material.conductivity, dtype=float)
         out = {}
         for w in self.walls:
+            if names is not None and w.name not in names:
+                continue
             nd, dl = self._wall_contacts[w.name]
             if nd.size and nd.max() >= graph.n_nodes:
                 raise ValueError(f"wall {w.name!r}: contact node index beyond the graph's {graph.n_nodes} nodes")
@@ -317,9 +319,10 @@ class ElectroThermalModel:
         """Give the heat solver the walls' contacts; True if they were new."""
         if not self.walls or self._walls_applied is graph:
             return False
-        for name, (nd, G) in self.wall_conductances(graph).items():
-            if name in self.heat.nodes_of:              # isothermal: a linked fixed temperature
-                self.heat.set_links(name, nd, G, assemble=assemble)
+        # isothermal walls only (a linked fixed temperature); an adiabatic wall conducts nothing
+        isothermal = [w.name for w in self.walls if w.name in self.heat.nodes_of]
+        for name, (nd, G) in self.wall_conductances(graph, isothermal).items():
+            self.heat.set_links(name, nd, G, assemble=assemble)
         self._walls_applied = graph
         return True
 
