@@ -555,6 +555,10 @@ def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
         if groups:
             np.testing.assert_allclose(Kud.toarray(), np.column_stack([L[np.ix_(u, g)].sum(axis=1) for g in groups]),
                                        rtol=1e-13, atol=1e-13)
+        else:           # no group: empty blocks (a shortcut path), nothing leaves through a group
+            assert Kud.shape == (n, 0) and rs.Kdd.shape == (0, 0) and rs.Kdu is None
+            assert rs.group_flux(rng.random(n), np.zeros(0)).shape == (0,)
+            assert np.array_equal(rs.expand(np.arange(n, dtype=float), []), np.arange(n))
 
 
 @pytest.mark.parametrize("repeats", [False, True])

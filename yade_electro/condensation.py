@@ -81,6 +81,12 @@ def _map(slots, edge, sign, nnz, m):
     return sp.csr_matrix((sign, (slots, edge)), shape=(nnz, m))
 
 
+def _empty_csr(rows: int, cols: int):
+    """An all-zero CSR matrix (no stored entry)."""
+    return sp.csr_matrix((np.zeros(0), np.zeros(0, dtype=np.int32), np.zeros(rows + 1, dtype=np.int32)),
+                         shape=(rows, cols))
+
+
 class ReducedSystem:
     """Structure of a network Laplacian condensed on Dirichlet groups.
 
@@ -159,26 +165,33 @@ class ReducedSystem:
         self._incidence.data[:] = 1.0
         del inc_rows, inc_cols
 
-        # K_ud: -c between an unknown and a group
-        rows = np.concatenate([ui[ud_i], uj[ud_j]])
-        cols = np.concatenate([gj[ud_i], gi[ud_j]])
-        self.Kud, slot, _ = _pattern(rows, cols, (nu, ng))
-        self._ud_map = _map(slot, np.concatenate([eid[ud_i], eid[ud_j]]), -np.ones(slot.size), self.Kud.nnz, m)
+        if ng == 0:
+            # no group (a heat problem without fixed temperatures): empty K_ud, K_dd and maps; scipy's
+            # constructors and transposes below cost about 1 ms at 2,000 unknowns, at each new structure
+            self.Kud, self.Kdd = _empty_csr(nu, 0), _empty_csr(0, 0)
+            self._ud_map = self._dd_map = None
+            self._Kdu_pattern, self._Kdu_from_ud = _empty_csr(0, nu), np.zeros(0, dtype=np.int64)
+        else:
+            # K_ud: -c between an unknown and a group
+            rows = np.concatenate([ui[ud_i], uj[ud_j]])
+            cols = np.concatenate([gj[ud_i], gi[ud_j]])
+            self.Kud, slot, _ = _pattern(rows, cols, (nu, ng))
+            self._ud_map = _map(slot, np.concatenate([eid[ud_i], eid[ud_j]]), -np.ones(slot.size), self.Kud.nnz, m)
 
-        # K_dd: group-group couplings and the group diagonals
-        rows = np.concatenate([gi[dd], gj[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
-        cols = np.concatenate([gj[dd], gi[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
-        self.Kdd, slot, _ = _pattern(rows, cols, (ng, ng))
-        ndd = int(dd.sum())
-        e_dd = eid[dd]
-        edge_of = np.concatenate([e_dd, e_dd, e_dd, e_dd, eid[ud_i], eid[ud_j]])
-        sign = np.concatenate([-np.ones(2 * ndd), np.ones(2 * ndd + int(ud_i.sum()) + int(ud_j.sum()))])
-        self._dd_map = _map(slot[:edge_of.size], edge_of, sign, self.Kdd.nnz, m)
-        # K_du = K_ud^T: its pattern once, and where each of its entries sits in K_ud.data
-        tagged = self.Kud.copy()
-        tagged.data = np.arange(1, tagged.nnz + 1, dtype=float)
-        self._Kdu_pattern = tagged.T.tocsr()
-        self._Kdu_from_ud = self._Kdu_pattern.data.astype(np.int64) - 1
+            # K_dd: group-group couplings and the group diagonals
+            rows = np.concatenate([gi[dd], gj[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
+            cols = np.concatenate([gj[dd], gi[dd], gi[dd], gj[dd], gj[ud_i], gi[ud_j], np.arange(ng)])
+            self.Kdd, slot, _ = _pattern(rows, cols, (ng, ng))
+            ndd = int(dd.sum())
+            e_dd = eid[dd]
+            edge_of = np.concatenate([e_dd, e_dd, e_dd, e_dd, eid[ud_i], eid[ud_j]])
+            sign = np.concatenate([-np.ones(2 * ndd), np.ones(2 * ndd + int(ud_i.sum()) + int(ud_j.sum()))])
+            self._dd_map = _map(slot[:edge_of.size], edge_of, sign, self.Kdd.nnz, m)
+            # K_du = K_ud^T: its pattern once, and where each of its entries sits in K_ud.data
+            tagged = self.Kud.copy()
+            tagged.data = np.arange(1, tagged.nnz + 1, dtype=float)
+            self._Kdu_pattern = tagged.T.tocsr()
+            self._Kdu_from_ud = self._Kdu_pattern.data.astype(np.int64) - 1
         self._Kdu = None
         self._assembled = False
         self._native = bool(native)     # K_uu filled by the compiled pass when it builds (its pattern too)
@@ -208,8 +221,9 @@ class ReducedSystem:
             data[self.diagonal_slots] += self._incidence @ c
             if diagonal is not None:
                 self.Kuu.data[self.diagonal_slots] += diagonal
-        self.Kud.data[:] = self._ud_map @ c
-        self.Kdd.data[:] = self._dd_map @ c
+        if self._ud_map is not None:
+            self.Kud.data[:] = self._ud_map @ c
+            self.Kdd.data[:] = self._dd_map @ c
         self._Kdu = None
         return self.Kuu, self.Kud
 
