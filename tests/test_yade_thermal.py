@@ -134,6 +134,9 @@ STATE_REPLACED = SCENE + r'''
 e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.1), "bottom": dict(select=BOTTOM, potential=0.0)},
                          density=7900, specific_heat=500, conductivity=15, temperature=293.15,
                          thermal_dt=1e-3, iterPeriod=1)
+import meshio
+early = meshio.read(e.write_vtk("vtk/early")["particles"]).point_data["temperature"]   # before any call
+early = [float(early.min()), float(early.max()), int(early.size)]
 O.engines = O.engines + [e.runner]
 O.run(3, True)
 w = e._temperature_writer
@@ -149,7 +152,7 @@ while calls < 20 and not (isinstance(b.state, ThermalState) and b.state.temp == 
     calls += 1
 out = dict(calls=calls, thermal=isinstance(b.state, ThermalState), temp=b.state.temp if isinstance(b.state, ThermalState) else None,
            model=float(e.temperature[k]), sweep=w.sweep_calls, refreshes=w.refreshes - refreshes, replaced=w.replaced_states,
-           others=max(abs(x.state.temp - t) for x, t in zip(e.reader.bodies, e.temperature.tolist())))
+           others=max(abs(x.state.temp - t) for x, t in zip(e.reader.bodies, e.temperature.tolist())), early=early)
 print(json.dumps(out))
 '''
 
@@ -157,9 +160,12 @@ print(json.dumps(out))
 def test_a_state_replaced_by_the_script_gets_the_temperatures(run_yade_script, tmp_path):
     """The engine keeps the bodies' State handles between calls (TemperatureWriter); a state a
     script replaces, here by a plain State without YADE's temp, is found by the sweep within
-    sweep_calls calls, made a ThermalState and given the model's temperature."""
+    sweep_calls calls, made a ThermalState and given the model's temperature. Also: write_vtk
+    before the engine's first call writes the starting state."""
     out = run_yade_script(STATE_REPLACED, timeout=120, cwd=tmp_path, check=True).result
     assert out["thermal"] and out["temp"] == out["model"] > 293.15
     assert 1 <= out["calls"] <= out["sweep"]
     assert out["refreshes"] == 1 and out["replaced"] == 1
     assert out["others"] == 0.0
+    # write_vtk before the first call: the starting state (the engine reads the scene when built)
+    assert out["early"][:2] == [293.15, 293.15] and out["early"][2] > 100
