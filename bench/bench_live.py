@@ -22,7 +22,7 @@ One JSON line per configuration::
      warm re-solve, write-back), "max_over_unchanged", "max_over_positions_read", "calls",
      "calls_by_kind", "structure_builds", "mech_step_ms", "load_average"}
 
-    yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4]
+    yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4] [--only engine/law/period,...]
 """
 from __future__ import annotations
 
@@ -161,6 +161,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--sizes", default="5000,20000")
     ap.add_argument("--blocks", type=int, default=12, help="pairs of blocks (with / without the engine)")
+    ap.add_argument("--only", default=None,
+                    help="run only these configurations, e.g. 'ElectricalEngine/continuum/100,"
+                         "ElectroThermalEngine/continuum/100' (engine/law/period, comma separated)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     rows = []
     for k, n in enumerate(int(x) for x in args.sizes.split(",")):
@@ -173,6 +176,9 @@ def main(argv=None):
         if k == 0:
             configs += [("ElectricalEngine", "voronoi", 1, steps_1), ("ElectricalEngine", "voronoi", 100, steps_100),
                         ("ElectroThermalEngine", "voronoi", 100, steps_100)]
+        if args.only:
+            wanted = {tuple(c.split("/")) for c in args.only.split(",")}
+            configs = [c for c in configs if (c[0], c[1], str(c[2])) in wanted]
         for kind, law, period, steps in configs:
             rows.append(bench(n, kind, law, period, steps, args.blocks))
     return rows
