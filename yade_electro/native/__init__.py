@@ -65,7 +65,8 @@ import numpy as np
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
-           "laplacian_fill", "triangle_distance", "triangle_candidates", "facet_vertices", "contact_radii", "pair_lengths",
+           "laplacian_fill", "triangle_distance", "triangle_candidates", "facet_vertices", "contact_radii",
+           "pair_lengths",
            "continuum_factors", "csr_pattern"]
 
 HERE = Path(__file__).resolve().parent

@@ -63,9 +63,9 @@ from ..errors import GraphError
 from ..graph import ContactGraph
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "write_body_attribute", "TemperatureWriter", "ensure_thermal_state", "predicate_selector", "check_write_back",
-           "BOND_CHECKS", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced", "warn_left_out",
-           "PERIODIC_REFUSAL"]
+__all__ = ["SceneReader", "write_body_attribute", "TemperatureWriter", "ensure_thermal_state", "predicate_selector",
+           "check_write_back", "BOND_CHECKS", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced",
+           "warn_left_out", "PERIODIC_REFUSAL"]
 
 log = logging.getLogger(__name__)
 
