@@ -47,8 +47,9 @@ def main(argv=None):
     ap.add_argument("--periods", default="10,100")
     ap.add_argument("--skin", type=float, default=None, help="Verlet skin in smallest radii (engine default)")
     ap.add_argument("--reference", action="store_true",
-                    help="also time two stand-in PyRunners every 10 steps (no engine): a 6 ms Python spin and "
-                         "the sum of a fresh 16 MB array, to see how any Python work slows YADE's own engines")
+                    help="also time three stand-in PyRunners every 10 steps (no engine): a 6 ms Python spin, the "
+                         "sum of a fresh 16 MB array and a 6 ms sleep (no work at all), to see how any pause of "
+                         "YADE's loop slows YADE's own engines")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     import numpy as np
     import rotating_drum as drum
@@ -122,12 +123,14 @@ def _spin(ms):
 
 def reference_rows(yade, O, args):
     """Stand-ins for the engine, every 10 steps, blocks interleaved with dead ones as for the
-    engine: ``spin`` (a 6 ms pure-Python loop) and ``alloc`` (numpy sums a fresh 16 MB
-    array). One JSON line each: the time per step in YADE's own engines alive and dead."""
+    engine: ``spin`` (a 6 ms pure-Python loop), ``alloc`` (numpy sums a fresh 16 MB array)
+    and ``sleep`` (``time.sleep(0.006)``: no work, no memory touched, only a pause of YADE's
+    loop). One JSON line each: the time per step in YADE's own engines alive and dead."""
     import builtins
     builtins._bench_granular_spin = _spin
     runners = {"spin": yade.PyRunner(command="__import__('builtins')._bench_granular_spin(6.0)", iterPeriod=10),
-               "alloc": yade.PyRunner(command="__import__('numpy').random.rand(2000000).sum()", iterPeriod=10)}
+               "alloc": yade.PyRunner(command="__import__('numpy').random.rand(2000000).sum()", iterPeriod=10),
+               "sleep": yade.PyRunner(command="__import__('time').sleep(0.006)", iterPeriod=10)}
     O.engines = O.engines + list(runners.values())
     mechanics = [e for e in O.engines if type(e).__name__ != "PyRunner"]
     O.timingEnabled = True
