@@ -49,7 +49,8 @@ def main(argv=None):
     ap.add_argument("--reference", action="store_true",
                     help="also time three stand-in PyRunners every 10 steps (no engine): a 6 ms Python spin, the "
                          "sum of a fresh 16 MB array and a 6 ms sleep (no work at all), to see how any pause of "
-                         "YADE's loop slows YADE's own engines")
+                         "YADE's loop slows YADE's own engines; and the time of each of the 10 steps after such a "
+                         "pause")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     import numpy as np
     import rotating_drum as drum
@@ -125,7 +126,8 @@ def reference_rows(yade, O, args):
     """Stand-ins for the engine, every 10 steps, blocks interleaved with dead ones as for the
     engine: ``spin`` (a 6 ms pure-Python loop), ``alloc`` (numpy sums a fresh 16 MB array)
     and ``sleep`` (``time.sleep(0.006)``: no work, no memory touched, only a pause of YADE's
-    loop). One JSON line each: the time per step in YADE's own engines alive and dead."""
+    loop). One JSON line each: the time per step in YADE's own engines alive and dead; then
+    :func:`pause_decay`'s line."""
     import builtins
     builtins._bench_granular_spin = _spin
     runners = {"spin": yade.PyRunner(command="__import__('builtins')._bench_granular_spin(6.0)", iterPeriod=10),
@@ -157,7 +159,29 @@ def reference_rows(yade, O, args):
                "load": round(os.getloadavg()[0], 2)}
         rows.append(row)
         print(json.dumps(row), flush=True)
+    rows.append(pause_decay(O, args.pairs))
     return rows
+
+
+def pause_decay(O, repeats, pause_ms=6.0, steps=10):
+    """The shape of that slowdown: each of ``steps`` single ``O.step()`` calls timed after
+    no pause, a ``pause_ms`` sleep and a ``pause_ms`` Python spin, the three in turn,
+    ``repeats`` times. One JSON line with the mean time of each step after each [ms]."""
+    import numpy as np
+    pauses = {"none": lambda: None, "sleep": lambda: time.sleep(pause_ms * 1e-3), "spin": lambda: _spin(pause_ms)}
+    spent = {name: np.zeros(steps) for name in pauses}
+    for _ in range(repeats):
+        for name, pause in pauses.items():
+            pause()
+            for k in range(steps):
+                t = time.perf_counter()
+                O.step()
+                spent[name][k] += time.perf_counter() - t
+    row = {"bench": "granular", "case": "drum_pause_decay", "pause_ms": pause_ms, "repeats": repeats,
+           **{f"step_ms_after_{name}": np.round(1e3 * v / repeats, 3).tolist() for name, v in spent.items()},
+           "load": round(os.getloadavg()[0], 2)}
+    print(json.dumps(row), flush=True)
+    return row
 
 
 if __name__ == "__main__":
