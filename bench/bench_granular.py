@@ -2,26 +2,28 @@
 ``cases/rotating_drum.py`` (about 2,000 copper particles, 20 rpm, smooth isothermal shell,
 adiabatic ends), one process, blocks with and without the engine interleaved.
 
-For each engine period (10 and 100 steps) one engine is made and its first calls (the
+For each engine period (10 and 100 steps) and mode (``plain``: the default engine;
+``overlap``: ``overlap=True``, its numpy work on a worker thread) one engine is made and its first calls (the
 first Verlet list, the solver setup) run before the timing; then ``--pairs`` pairs of blocks
 of ``--steps`` steps each run, one with the engine alive and one with it dead (its PyRunner
-skipped), the order swapped every pair. Prints one JSON line per period::
+skipped), the order swapped every pair. Prints one JSON line per period and mode::
 
-    {"bench": "granular", "case": "drum", "n", "rpm", "period", "skin",
+    {"bench": "granular", "case": "drum", "n", "rpm", "period", "overlap", "skin",
      "ratio": wall_with / wall_without (sums over the blocks),
      "ratio_median_of_pairs": the median of the pairs' ratios (less sensitive to the
          machine's noise),
      "engine_share": 1 - 1 / ratio_median_of_pairs (target < 0.2 every 10 steps),
      "engine_share_of_sums": 1 - 1 / ratio,
      "calls_share": time inside the engine's calls / wall_with,
-     "call_ms": the engine's own time per call (measured inside the calls),
+     "call_ms": the engine's own time per call (measured inside the calls; with ``overlap``
+         the part that pauses YADE's loop, the worker thread's part not included),
      "yade_step_ms": wall_without / steps, "list_builds_per_call",
      "yade_engines_ms_with", "yade_engines_ms_without": the time per step inside YADE's own
          engines (their ``execTime``, ``O.timingEnabled``) with the engine alive and dead: how
          much the engine's calls slow YADE's own work down between them,
      "load"}
 
-    yade-electro -n -x bench/bench_granular.py [--n 2000] [--steps 100] [--pairs 40]
+    yade-electro -n -x bench/bench_granular.py [--n 2000] [--steps 100] [--pairs 40] [--modes plain,overlap]
 """
 from __future__ import annotations
 
@@ -46,6 +48,9 @@ def main(argv=None):
     ap.add_argument("--pairs", type=int, default=40, help="pairs of blocks (with / without the engine)")
     ap.add_argument("--periods", default="10,100")
     ap.add_argument("--skin", type=float, default=None, help="Verlet skin in smallest radii (engine default)")
+    ap.add_argument("--modes", default="plain,overlap",
+                    help="engines to time at each period: 'plain' (default engine) and/or 'overlap' (overlap=True: "
+                         "the numpy work on a worker thread while YADE steps on)")
     ap.add_argument("--reference", action="store_true",
                     help="also time three stand-in PyRunners every 10 steps (no engine): a 6 ms Python spin, the "
                          "sum of a fresh 16 MB array and a 6 ms sleep (no work at all), to see how any pause of "
@@ -65,8 +70,13 @@ def main(argv=None):
     out = []
     if args.reference:
         out += reference_rows(yade, O, args)
-    for period in (int(p) for p in args.periods.split(",")):
-        engine = drum.heat_engine(ids, hot, label="bench_granular", iterPeriod=period, skin=args.skin)
+    runs = [(int(p), m) for p in args.periods.split(",") for m in args.modes.split(",")]
+    bad = {m for _, m in runs} - {"plain", "overlap"}
+    if bad:
+        ap.error(f"--modes: unknown {sorted(bad)}; give plain and/or overlap")
+    for period, mode_name in runs:
+        engine = drum.heat_engine(ids, hot, label="bench_granular", iterPeriod=period, skin=args.skin,
+                                  overlap=mode_name == "overlap")
         O.engines = O.engines + [engine.runner]
         O.run(max(2 * period, args.steps), True)      # first calls and the skin's adaptation out of the blocks
         inner = engine._step
@@ -97,11 +107,13 @@ def main(argv=None):
                 wall[mode] += w[mode]
             pair_ratios.append(w["with"] / w["without"])
         O.timingEnabled = False
+        engine.sync()
         calls = engine.reader.calls - c0
         builds = engine.reader.list_builds - b0
         engine.remove()
         ratio, med = wall["with"] / wall["without"], float(np.median(pair_ratios))
         row = {"bench": "granular", "case": "drum", "n": int(sph.size), "rpm": args.rpm, "period": period,
+               "overlap": mode_name == "overlap",
                "skin": engine.reader.skin, "ratio": round(ratio, 3), "ratio_median_of_pairs": round(med, 3),
                "engine_share": round(1.0 - 1.0 / med, 3), "engine_share_of_sums": round(1.0 - 1.0 / ratio, 3),
                "calls_share": round(spent[0] / wall["with"], 3),

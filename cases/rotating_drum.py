@@ -148,9 +148,9 @@ def start_rotation(ids, rpm):
     return rot
 
 
-def heat_engine(ids, hot, label="drum_heat", iterPeriod=ENGINE_PERIOD, history=None, skin=None):
+def heat_engine(ids, hot, label="drum_heat", iterPeriod=ENGINE_PERIOD, history=None, skin=None, overlap=False):
     """The bed's HeatEngine: the left half hot, the shell (and baffles) at T_WALL, the ends
-    adiabatic."""
+    adiabatic (``overlap``: the engine's ``overlap=``)."""
     from yade_electro.yade import HeatEngine
     walls = {"shell": dict(bodies=ids["shell"], temperature=T_WALL),
              "ends_minus": dict(bodies=ids["ends"][0], temperature=None),
@@ -159,7 +159,7 @@ def heat_engine(ids, hot, label="drum_heat", iterPeriod=ENGINE_PERIOD, history=N
         walls["baffles"] = dict(bodies=ids["baffles"], temperature=T_WALL)
     return HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T_COLD, initial_temperature={int(i): T_HOT for i in hot},
                       bonds="contacts", law="contact", walls=walls, theta="explicit", iterPeriod=iterPeriod,
-                      label=label, history=history, **({} if skin is None else {"skin": skin}))
+                      label=label, history=history, overlap=overlap, **({} if skin is None else {"skin": skin}))
 
 
 def lacey_index(pos, is_a, cell=8 * PARTICLE_RADIUS, min_count=5) -> float:

@@ -30,7 +30,7 @@ O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall
 O.dt = 0.5 * utils.PWaveTimeStep()
 hot = {i: 373.15 for i in ids if O.bodies[i].state.pos[2] > 0.015}
 e = HeatEngine(8900, 172, 385, 273.15, initial_temperature=hot, bonds="contacts", law=LAW,
-               walls={"floor": dict(bodies=floor, temperature=WALL_T)}, theta=THETA, iterPeriod=10)
+               walls={"floor": dict(bodies=floor, temperature=WALL_T)}, theta=THETA, iterPeriod=10, overlap=OVERLAP)
 O.engines = O.engines + [e.runner]
 heat_init = e.coupled.summary()["heat_content"]
 rows = []
@@ -54,9 +54,10 @@ print(json.dumps({"heat_init": heat_init, "heat": r["heat_content"], "wall_heat"
 
 
 def _bed(run_yade_script, tmp_path, wall_t="None", law="'contact'", theta="'explicit'", erase=False, gap="0.001",
-         gravity="-9.81", chunks=6):
+         gravity="-9.81", chunks=6, overlap=False):
     src = (BED.replace("WALL_T", wall_t).replace("LAW", law).replace("THETA", theta).replace("ERASE", repr(erase))
-           .replace("GAP", gap).replace("GRAVITY", gravity).replace("CHUNKS", str(chunks)))
+           .replace("GAP", gap).replace("GRAVITY", gravity).replace("CHUNKS", str(chunks))
+           .replace("OVERLAP", repr(overlap)))
     return run_yade_script(src, timeout=300, cwd=tmp_path, check=True).result
 
 
@@ -87,8 +88,9 @@ def test_a_bed_without_contacts_keeps_its_temperatures(run_yade_script, tmp_path
     assert out["heat"] == out["heat_init"] and out["wall_heat"] == 0.0
 
 
-def test_a_particle_leaving_the_bed(run_yade_script, tmp_path):
-    out = _bed(run_yade_script, tmp_path, wall_t="473.15", erase=True)
+@pytest.mark.parametrize("overlap", [False, True], ids=["plain", "overlap"])
+def test_a_particle_leaving_the_bed(run_yade_script, tmp_path, overlap):
+    out = _bed(run_yade_script, tmp_path, wall_t="473.15", erase=True, overlap=overlap)
     assert out["finite"] and out["full_reads"] == 2          # the erased body was seen once
     assert out["wall_heat"] > 0 and out["particle_heat"] < 0  # the hot particle took its heat away
     # the balance closes with the heat it took: stored = given by the wall + carried by particles
@@ -122,6 +124,8 @@ cases = {
     "solid_law_granular": dict(bonds="contacts", law="continuum"),
     "walls_bonded": dict(bonds="cohesive", law="continuum", walls={"w": dict(bodies=floor, temperature=300.0)}),
     "bad_skin": dict(bonds="contacts", skin=-1.0),
+    "overlap_bonded": dict(bonds="cohesive", law="continuum", overlap=True),
+    "overlap_not_bool": dict(bonds="contacts", overlap="yes"),
 }
 for name, kw in cases.items():
     out[name] = outcome(lambda: HeatEngine(8900, 172, 385, 273.15, label="bad_" + name, **kw))
@@ -131,6 +135,10 @@ for name, kw in {"wall_electrode_no_contact": dict(bonds="contacts"),
     out[name] = outcome(lambda: ElectricalEngine(1e-7, {"plate": dict(wall=floor, potential=0.0),
                                                         "top": dict(select=[s[1]], potential=1.0)},
                                                  label="bad_" + name, **kw))
+from yade_electro.yade import ElectroThermalEngine
+out["overlap_electrodes"] = outcome(lambda: ElectroThermalEngine(
+    1e-7, {"a": dict(select=[s[0]], potential=0.0), "b": dict(select=[s[1]], potential=1.0)}, 8900, 172, 385, 273.15,
+    bonds="contacts", law="contact", overlap=True, label="bad_overlap_electrodes"))
 print(json.dumps(out))
 '''
 
@@ -138,6 +146,9 @@ print(json.dumps(out))
 def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path):
     out = run_yade_script(BAD, timeout=120, cwd=tmp_path, check=True).result
     assert "is a Sphere, not a wall" in out["wall_on_sphere"]
+    for name in ("overlap_bonded", "overlap_electrodes"):
+        assert out[name].startswith("ValueError: overlap=True is for heat-only engines in the granular mode"), name
+    assert out["overlap_not_bool"].startswith("ValueError: overlap must be True or False")
     assert "no body 99" in out["wall_missing"]
     assert "unknown key(s) ['temp']" in out["wall_bad_key"]
     assert out["contact_law_bonded"].startswith("ValueError") and "bonds='contacts'" in out["contact_law_bonded"]
@@ -345,6 +356,66 @@ def test_granular_save_and_load_continues(run_yade_script, tmp_path):
     assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)
 
 
+OVERLAPPED_BED = SAVED_BED.replace('history="h.csv")', 'history="h.csv", overlap=True)')
+
+
+def test_overlapped_calls_give_the_same_bed_one_call_later(run_yade_script, tmp_path):
+    # overlap=True: the same temperatures, heat and history as the plain engine; the bodies
+    # hold the call before last until the engine publishes the last one (sync, or a result)
+    import numpy as np
+    script = r"""
+e = build()
+ids = e.body_ids          # (asking the engine for a result publishes: read the bodies' own)
+T_bodies = lambda: np.array([O.bodies[int(i)].state.temp for i in ids])
+O.run(1000, True)
+before = T_bodies()
+f = figures(e)
+print(json.dumps(dict(f, before=before.tolist(), after=T_bodies().tolist(), published=e.sync() is None,
+                      T_engine=e.temperature.tolist())))
+"""
+    plain = run_yade_script(SAVED_BED + script, timeout=300, cwd=tmp_path, check=True).result
+    over = run_yade_script(OVERLAPPED_BED + script, timeout=300, cwd=tmp_path, check=True).result
+    assert over["rows"] == plain["rows"] == 100 and over["time"] == plain["time"]
+    assert np.max(np.abs(np.array(over["T_engine"]) - plain["T_engine"])) <= 1e-12 * 100
+    assert over["wall_heat"] == pytest.approx(plain["wall_heat"], rel=1e-12) and plain["wall_heat"] > 0
+    assert over["heat"] == pytest.approx(over["wall_heat"], rel=1e-9)
+    assert plain["before"] == plain["after"] == plain["T_engine"]
+    assert over["after"] == over["T_engine"] and over["published"]       # figures() published it
+    assert np.max(np.abs(np.array(over["before"]) - over["T_engine"])) > 1e-6     # one call behind
+
+
+def test_an_overlapped_call_that_fails_is_raised_at_the_next_call(run_yade_script, tmp_path):
+    script = r"""
+e = build()
+O.run(100, True)
+def broken(graph, dt):
+    raise ZeroDivisionError("broken on purpose")
+e.coupled.step = broken
+start = O.iter
+try:
+    O.run(30, True)
+    caught = None
+except Exception as exc:
+    caught = type(exc).__name__
+print(json.dumps(dict(caught=caught, error=f"{type(e.error).__name__}: {e.error}", steps=O.iter - start,
+                      then=e.sync())))
+"""
+    out = run_yade_script(OVERLAPPED_BED + script, timeout=300, cwd=tmp_path, check=True).result
+    assert out["caught"] == "RuntimeError" and out["error"] == "ZeroDivisionError: broken on purpose"
+    assert out["steps"] <= 11 and out["then"] is None       # stopped at the next call; nothing left pending
+
+
+def test_overlapped_bed_saved_and_loaded_continues_exactly(run_yade_script, tmp_path):
+    # a save between two calls holds the unpublished call's input: the loaded run replays it
+    import numpy as np
+    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, OVERLAPPED_BED, 1000, 1000)
+    assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
+    assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 273.15))
+    assert out["wall_heat"] == pytest.approx(ref["wall_heat"], rel=1e-9) and ref["wall_heat"] > 0
+    hist = (tmp_path / "run" / "h.csv").read_text().splitlines()
+    assert len(hist) == 1 + ref["rows"] and not (tmp_path / "run" / "h.csv.after-save.csv").exists()
+
+
 def test_temperatures_set_before_a_save_are_kept(run_yade_script, tmp_path):
     # set_temperatures, then O.save before the engine's next call: the run loaded in a new
     # process applies them at its first call, as the uninterrupted run does
@@ -450,9 +521,12 @@ def figures(e):
 '''
 
 
-def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path):
+@pytest.mark.parametrize("overlap", [False, True], ids=["plain", "overlap"])
+def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path, overlap):
     import numpy as np
-    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, SAVED_PERIODIC, 100, 100)
+    scene = SAVED_PERIODIC.replace('history="h.csv",', 'history="h.csv", overlap=True,') if overlap else SAVED_PERIODIC
+    assert scene.count("overlap=True") == int(overlap)
+    ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, scene, 100, 100)
     assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
     assert np.max(np.abs(tb - ta)) <= 1e-9 * np.max(np.abs(ta - 300.0))
     assert abs(ref["heat"]) < 1e-9 * 10.0 * 125 * 8900 * 172 * 4 / 3 * np.pi * 0.00201 ** 3   # a cosine: no net heat

@@ -28,12 +28,16 @@ it), and ``engine = yade_electro.yade.attach(label)`` gives back a handle.
 """
 from __future__ import annotations
 
+import base64
 import dataclasses
 import logging
 import os
+import pickle
 import sys
+import threading
 import warnings
-from typing import Dict, Optional
+from concurrent.futures import ThreadPoolExecutor
+from typing import Dict, NamedTuple, Optional
 
 import numpy as np
 
@@ -46,7 +50,7 @@ from ..materials import real_number
 from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
 from . import persistence, registry
 from .runtime import import_yade
-from .granular import GranularReader, check_wall_bodies
+from .granular import Capture, GranularReader, check_wall_bodies
 from .scene import SceneReader, TemperatureWriter, check_write_back, predicate_selector, write_body_attribute
 
 __all__ = ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "engine_class"]
@@ -238,6 +242,9 @@ class _Engine:
     def _restore_history(self, state):
         rows = int(state.get("rows", len(self.history))) if state else len(self.history)
         extra = self.history.truncate(rows)
+        replayed = state.get("overlap_iter") if state else None
+        if extra and replayed is not None and int(float(extra[0].get("iter", -1))) == int(replayed):
+            extra = extra[1:]       # the unpublished overlapped call's row: the replay writes it again
         if extra and self.history.path:
             side = self.history.path + ".after-save.csv"
             h = History(side, "w")
@@ -304,8 +311,12 @@ class _Engine:
     def _write_row(self, row):
         self.history.append(row)
         if self.plot:
-            from yade import plot
-            plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
+            self._plot_row(row)
+
+    @staticmethod
+    def _plot_row(row):
+        from yade import plot
+        plot.addData(**{f"electro_{k}" if k not in ("iter", "time") else k: v for k, v in row.items()})
 
 
 #: why an engine does not run inside yade.mpy's domain decomposition
@@ -625,9 +636,24 @@ class ElectroThermalEngine(ElectricalEngine):
         others keep them). Looked up again whenever the element set changes (a full read).
         Edges take the harmonic mean of their two conductivities and the mean of their
         resistivities; a wall contact the harmonic mean of the particle's and the wall's.
+    overlap : bool
+        Heat-only engines in the granular mode (``electrodes=None``, ``bonds='contacts'``):
+        run each call's numpy work (the Verlet lists, the walls' overlaps, the conductances,
+        the heat step and the history row) on a worker thread while YADE steps on, so that a
+        call pauses YADE's loop only to read the scene and write temperatures (default False).
+        The price is a lag of one call: the temperatures a call computes reach ``b.state.temp``
+        (and ``yade.plot``) at the next call. The engine's own results (``temperature``,
+        ``wall_heat``, ``coupled``, ...) and :meth:`sync` wait for the last call and publish
+        it; a scene saved in between holds the unpublished call's input, so a loaded run
+        continues exactly as an uninterrupted one. The history row is written as soon as the
+        call is computed. See the README (*Granular mode*) for when it pays.
     """
 
     DEFAULT_LABEL = "electrothermal"
+
+    #: the call computed on the worker thread and not yet published (overlap=True)
+    _inflight = None
+    overlap = False
 
     def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
                  temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(),
@@ -639,7 +665,15 @@ class ElectroThermalEngine(ElectricalEngine):
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
                  label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
-                 materials=None, O=None, _resume=None):
+                 materials=None, overlap=False, O=None, _resume=None):
+        if not isinstance(overlap, bool):
+            raise ValueError(f"overlap must be True or False, got {overlap!r}")
+        if overlap and (electrodes is not None or bonds != "contacts"):
+            raise ValueError("overlap=True is for heat-only engines in the granular mode (electrodes=None, "
+                             "bonds='contacts'); leave it False here")
+        self._drop_inflight()                  # a re-attach in place: the old scene's call is void
+        self.overlap = overlap
+        self._resumed_work = None
         wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
@@ -702,7 +736,7 @@ class ElectroThermalEngine(ElectricalEngine):
         self._thermal = dict(density=density, specific_heat=specific_heat, conductivity=conductivity,
                              temperature=temperature, beta=beta, eta=eta, theta=theta, thermal_dt=thermal_dt,
                              time_scale=time_scale, thermal_solver=thermal_solver, steady=steady,
-                             coupled_options=dict(coupled_options or {}))
+                             coupled_options=dict(coupled_options or {}), overlap=overlap)
         extra = dict(coupled_options or {})
         if bonds == "contacts" and "cell_volume" not in extra:
             extra.setdefault("volume_fraction", 1.0)     # a particle is its own volume
@@ -724,7 +758,78 @@ class ElectroThermalEngine(ElectricalEngine):
             self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
             self.coupled.restore_temperatures(self._read_temperatures)
             self._pending_temperatures = {int(k): float(v) for k, v in (st.get("pending") or {}).items()}
+            saved_call = persistence.load_call(self.O, self.label) if st.get("overlap_iter") is not None else None
+            if saved_call:
+                self._resumed_work = _decode_work(saved_call)
         self._finish(history_mode)
+
+    # -- the model, and the overlapped call -----------------------------------------------
+    @property
+    def coupled(self) -> ElectroThermalModel:
+        """The engine's ElectroThermalModel (after :meth:`sync`: up to date with the last call)."""
+        self.sync()
+        return self._coupled
+
+    @coupled.setter
+    def coupled(self, model):
+        self._coupled = model
+
+    @property
+    def history(self) -> History:
+        """The engine's History (after :meth:`sync`: with the last call's row)."""
+        self.sync()
+        return self._history
+
+    @history.setter
+    def history(self, history):
+        self._history = history
+
+    def sync(self) -> Optional[dict]:
+        """With ``overlap=True``: wait for the last call's work on the worker thread and publish
+        it (temperatures to ``b.state.temp``, ``yade.plot``); returns its history row (None
+        when nothing was pending). A worker's error is raised here. Without overlap: nothing."""
+        return self._publish_inflight(save=True)
+
+    def _publish_inflight(self, save: bool) -> Optional[dict]:
+        if self._inflight is None or getattr(_WORKER, "active", False):
+            return None
+        future, bodies = self._inflight
+        self._inflight = None
+        try:
+            out, temperatures = future.result()
+        except Exception as exc:
+            self.error = exc
+            log.error("yade-electro engine %r failed in its overlapped call: %s: %s", self.label,
+                      type(exc).__name__, exc)
+            raise
+        self._temperature_writer.write(bodies, temperatures)
+        if self.plot:
+            self._plot_row(out)
+        if save:
+            self._save_state()
+        return out
+
+    def _drop_inflight(self):
+        """Wait for a pending overlapped call and discard it (its scene was replaced)."""
+        if self._inflight is not None:
+            future, _ = self._inflight
+            self._inflight = None
+            future.exception()
+
+    def _executor(self) -> ThreadPoolExecutor:
+        if getattr(self, "_pool", None) is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=f"yade-electro-{self.label}")
+        return self._pool
+
+    def remove(self):
+        """Publish a pending overlapped call, then as ``_Engine.remove``."""
+        try:
+            self.sync()
+        finally:
+            super().remove()
+            if getattr(self, "_pool", None) is not None:
+                self._pool.shutdown(wait=True)
+                self._pool = None
 
     @staticmethod
     def _wall_specs(walls):
@@ -855,14 +960,21 @@ class ElectroThermalEngine(ElectricalEngine):
         return kw
 
     def _save_state(self):
-        heat = self.coupled.heat
-        persistence.save_state(self.O, self.label, {
-            "iter": int(self.O.iter), "time": float(self.O.time), "mech_time": self._last_time,
-            "values": dict(self.model.values) if self.model is not None else {},
-            "thermal_time": self.coupled.time, "energy": self.coupled.energy_ledger,
-            "fixed_values": heat.fixed_values if heat is not None else {},
-            "pending": {str(k): v for k, v in self._pending_temperatures.items()},
-            "rows": len(self.history)})
+        if self._inflight is not None and not getattr(_WORKER, "active", False):
+            state = dict(self._inflight_state)      # the model is the worker's now
+            state["pending"] = {str(k): v for k, v in self._pending_temperatures.items()}
+        else:
+            state = self._state_dict()
+        persistence.save_state(self.O, self.label, state)
+
+    def _state_dict(self) -> dict:
+        heat = self._coupled.heat
+        return {"iter": int(self.O.iter), "time": float(self.O.time), "mech_time": self._last_time,
+                "values": dict(self.model.values) if self.model is not None else {},
+                "thermal_time": self._coupled.time, "energy": self._coupled.energy_ledger,
+                "fixed_values": heat.fixed_values if heat is not None else {},
+                "pending": {str(k): v for k, v in self._pending_temperatures.items()},
+                "rows": len(self.history)}
 
     def _prepare(self, graph):
         if self._resume is not None and self.model is not None:
@@ -898,20 +1010,13 @@ class ElectroThermalEngine(ElectricalEngine):
         return self._guarded(lambda: self._step(steady=True))
 
     def _step(self, steady=None):
+        if self.overlap and steady is None:
+            return self._step_overlapped()
+        self.sync()
         graph = self.reader.read()
-        self._feed_walls()
         self._apply_materials()
-        self._apply_pending_temperatures(graph)
-        if self.thermal_dt is not None:
-            dt = self.thermal_dt
-        else:
-            dt = (float(self.O.time) - self._last_time) * self.time_scale
-        if self.steady if steady is None else steady:
-            row = self.coupled.steady_state(graph)
-        elif dt <= 0:           # first call at the start of a run: nothing to integrate yet
-            row = self.coupled.refresh(graph)
-        else:
-            row = self.coupled.step(graph, dt)
+        pending, self._pending_temperatures = self._pending_temperatures, {}
+        row = self._heat_step(graph, self._call_dt(), steady, pending)
         self._last_time = float(self.O.time)
         bodies = self.reader.bodies
         self._temperature_writer.write(bodies, self.coupled.temperature)
@@ -919,11 +1024,78 @@ class ElectroThermalEngine(ElectricalEngine):
         if self.write_back and sol is not None and sol is not self._written:
             write_body_attribute(bodies, self.write_back, sol.potential)
             self._written = sol
-        out = {"iter": int(self.O.iter), "mech_time": float(self.O.time)}
-        out.update(row)
-        out["graph_revision"] = int(graph.revision)
+        out = self._row(int(self.O.iter), float(self.O.time), row, graph)
         self._write_row(out)
         return out
+
+    def _call_dt(self) -> float:
+        """The thermal step of a call now [s]."""
+        if self.thermal_dt is not None:
+            return self.thermal_dt
+        return (float(self.O.time) - self._last_time) * self.time_scale
+
+    def _heat_step(self, graph, dt, steady, pending) -> dict:
+        """The model's part of a call (numpy only): walls, set temperatures, then a steady
+        solve, a refresh (no time elapsed) or a step of ``dt`` [s]."""
+        self._feed_walls()
+        self._apply_pending_temperatures(graph, pending)
+        if self.steady if steady is None else steady:
+            return self.coupled.steady_state(graph)
+        if dt <= 0:           # first call at the start of a run: nothing to integrate yet
+            return self.coupled.refresh(graph)
+        return self.coupled.step(graph, dt)
+
+    @staticmethod
+    def _row(iteration, mech_time, row, graph) -> dict:
+        out = {"iter": int(iteration), "mech_time": float(mech_time)}
+        out.update(row)
+        out["graph_revision"] = int(graph.revision)
+        return out
+
+    def _step_overlapped(self):
+        """One call with ``overlap=True``: publish the previous call, read the scene, save the
+        state (the published one, plus this call's input), hand the rest to the worker."""
+        if self._resumed_work is not None:          # a loaded scene's call that was not published
+            work, self._resumed_work = self._resumed_work, None
+            self._resume_work(work)
+        self._publish_inflight(save=False)         # the state saved below covers it
+        state = self._state_dict()
+        work = _Work(self.reader.capture(), self._call_dt(), None, int(self.O.iter), float(self.O.time))
+        self._apply_materials()
+        work = work._replace(pending=self._pending_temperatures)
+        self._pending_temperatures = {}
+        self._last_time = work.mech_time
+        state["pending"] = {}
+        state["overlap_iter"] = work.iteration
+        persistence.save_call(self.O, self.label, _encode_work(work))
+        self._inflight_state = state
+        self._inflight = (self._executor().submit(self._compute, work), self.reader.bodies)
+        return None             # (_guarded saves the state)
+
+    def _compute(self, work: "_Work"):
+        """The worker's part of an overlapped call: (history row, temperatures [K])."""
+        _WORKER.active = True
+        try:
+            graph = self.reader.advance(work.capture)
+            row = self._heat_step(graph, work.dt, None, work.pending)
+            out = self._row(work.iteration, work.mech_time, row, graph)
+            self.history.append(out)
+            return out, np.array(self._coupled.temperature, dtype=float)
+        finally:
+            _WORKER.active = False
+
+    def _resume_work(self, work: "_Work"):
+        """Compute and publish the saved unpublished call of a loaded scene (same spheres)."""
+        if not np.array_equal(work.capture.ids, self.reader.graph.ids):
+            log.warning("engine %r: the spheres changed between the load and the first call; the saved call of "
+                        "iteration %d is not replayed (the next call integrates its interval)", self.label,
+                        work.iteration)
+            return
+        out, temperatures = self._compute(work)
+        self._temperature_writer.write(self.reader.bodies, temperatures)
+        if self.plot:
+            self._plot_row(out)
+        self._last_time = work.mech_time
 
     @property
     def temperature(self) -> np.ndarray:
@@ -965,18 +1137,16 @@ class ElectroThermalEngine(ElectricalEngine):
         self._pending_temperatures.update(checked)
         self._save_state()                  # an O.save before the next call keeps them
 
-    def _apply_pending_temperatures(self, graph):
-        if not self._pending_temperatures:
+    def _apply_pending_temperatures(self, graph, pending):
+        if not pending:
             return
-        ids = np.array(sorted(self._pending_temperatures), dtype=np.int64)
+        ids = np.array(sorted(pending), dtype=np.int64)
         here = np.isin(ids, graph.ids)
         if not np.all(here):
             log.warning("engine %r: set_temperatures for bodies %s that left the scene before the call; dropped",
                         self.label, ids[~here][:10].tolist())
         self.coupled.prepare(graph)
-        self.coupled.set_temperatures(graph.index_of(ids[here]),
-                                      [self._pending_temperatures[int(i)] for i in ids[here]])
-        self._pending_temperatures = {}
+        self.coupled.set_temperatures(graph.index_of(ids[here]), [pending[int(i)] for i in ids[here]])
 
 
 class HeatEngine(ElectroThermalEngine):
@@ -993,6 +1163,31 @@ class HeatEngine(ElectroThermalEngine):
         kwargs["electrodes"] = None
         super().__init__(density=density, specific_heat=specific_heat, conductivity=conductivity,
                          temperature=temperature, **kwargs)
+
+
+#: set on the worker thread while it computes an overlapped call
+_WORKER = threading.local()
+
+
+class _Work(NamedTuple):
+    """An overlapped call's input: what it read from YADE, its thermal step [s], the set
+    temperatures {body id: K} it applies, its iteration and time [s] (plain data: it pickles
+    into the scene's state, so a loaded scene replays it)."""
+
+    capture: Capture
+    dt: float
+    pending: Optional[Dict[int, float]]
+    iteration: int
+    mech_time: float
+
+
+def _encode_work(work: _Work) -> str:
+    return base64.b64encode(pickle.dumps(tuple(work), protocol=4)).decode("ascii")
+
+
+def _decode_work(text: str) -> _Work:
+    capture, dt, pending, iteration, mech_time = pickle.loads(base64.b64decode(text.encode("ascii")))
+    return _Work(Capture(*capture), float(dt), dict(pending or {}), int(iteration), float(mech_time))
 
 
 def engine_class(name: str):

@@ -37,7 +37,7 @@ from __future__ import annotations
 import logging
 from collections import Counter
 from operator import attrgetter
-from typing import Dict, List, Optional
+from typing import Dict, List, NamedTuple, Optional
 
 import numpy as np
 
@@ -48,7 +48,7 @@ from ..graph import ContactGraph
 from .runtime import import_yade
 from .scene import bulk_coordinates, probe_replaced, read_spheres, warn_left_out
 
-__all__ = ["GranularReader", "WALL_SHAPES", "check_wall_bodies"]
+__all__ = ["Capture", "GranularReader", "WALL_SHAPES", "check_wall_bodies"]
 
 log = logging.getLogger(__name__)
 
@@ -123,6 +123,20 @@ class _WallReader:
             pos = np.array([tuple(st.pos) for st in states], dtype=float)
         quat = np.array([(q[0], q[1], q[2], q[3]) for q in map(attrgetter("ori"), states)], dtype=float)
         return WallGeometry("triangles", vertices=facet_vertices(pos, quat, self._local))
+
+
+class Capture(NamedTuple):
+    """What :meth:`GranularReader.capture` read from YADE at one call (plain data: it pickles).
+
+    ``reason``: why the call made a full read (None: it did not); ``ids``: the graph's body
+    ids; ``pos`` (n, 3) [m]: their centres (not wrapped into a periodic cell); ``walls``: name
+    -> WallGeometry; ``cell`` (3, 3) [m]: a periodic cell's base vectors (columns), else None."""
+
+    reason: Optional[str]
+    ids: np.ndarray
+    pos: np.ndarray
+    walls: Dict[str, WallGeometry]
+    cell: Optional[np.ndarray]
 
 
 class GranularReader:
@@ -201,31 +215,46 @@ class GranularReader:
     # -- public --------------------------------------------------------------------------
     def read(self) -> ContactGraph:
         """The current graph (a new revision whenever the spheres moved)."""
+        return self.advance(self.capture())
+
+    def capture(self) -> "Capture":
+        """What :meth:`read` takes from YADE (a full read when the scene changed, the centres,
+        the walls' poses, the periodic cell), and nothing else: :meth:`advance` then makes the
+        graph from it without touching YADE, so it may run while YADE steps on."""
         self.calls += 1
         self.last_change = None
         reason = "first read" if self.graph is None else self._changed()
         if reason:
             self._full_read()
-            self.last_change = reason
         coords = bulk_coordinates(self._n_existing)
         pos = coords[self._node_slot]
         if not np.all(np.isfinite(pos)):
             bad = self.graph.ids[~np.all(np.isfinite(pos), axis=1)]
             raise GraphError(f"spheres {bad[:10].tolist()} have non-finite positions (the mechanics blew up?)")
         if self.periodic:
-            self.geometry_reads += 1
-            self._read_periodic(pos, bool(reason))
-            return self.graph
+            return Capture(reason, self.graph.ids, pos, {}, self._cell())
         geoms = {name: w.geometry(coords, self._slot_of) for name, w in self.walls.items()}
+        return Capture(reason, self.graph.ids, pos, geoms, None)
+
+    def advance(self, cap: "Capture") -> ContactGraph:
+        """The graph of a :meth:`capture` (the last one, or a saved one of the same spheres):
+        the Verlet lists, the new positions and the walls' overlaps (numpy only)."""
+        if not np.array_equal(cap.ids, self.graph.ids):
+            raise GraphError("this capture holds other spheres than the reader's graph (a full read came between)")
+        self.last_change = cap.reason
+        pos, geoms = cap.pos, cap.walls
         self.geometry_reads += 1
-        rebuild = bool(reason)
+        if self.periodic:
+            self._read_periodic(pos, bool(cap.reason), cap.cell)
+            return self.graph
+        rebuild = bool(cap.reason)
         if not rebuild:
             moved = max_displacement(pos, self._list_pos)
             walls_moved = max([geoms[k].moved(self._list_walls[k]) for k in geoms], default=0.0)
             rebuild = 2.0 * moved > self._skin_m or moved + walls_moved > self._skin_m
         if rebuild:
             self._make_lists(pos, geoms)
-            if not reason:
+            if not cap.reason:
                 self.last_change = "new Verlet list"
         elif not np.array_equal(pos, self.graph.pos):
             self._revision += 1
@@ -310,9 +339,9 @@ class GranularReader:
         h = self.O.cell.hSize
         return np.array([[h[i, j] for j in range(3)] for i in range(3)], dtype=float)
 
-    def _read_periodic(self, raw, rebuild):
-        """The graph of a periodic bed from the centres ``raw`` [m] (YADE's, not wrapped)."""
-        H = self._cell()
+    def _read_periodic(self, raw, rebuild, H):
+        """The graph of a periodic bed from the centres ``raw`` [m] (YADE's, not wrapped) and
+        the cell's base vectors ``H`` [m] (columns)."""
         if not (np.all(np.isfinite(H)) and abs(np.linalg.det(H)) > 0):
             raise GraphError(f"the periodic cell is degenerate (O.cell.hSize = {H.tolist()})")
         H_inv = np.linalg.inv(H)

@@ -8,7 +8,9 @@ YADE saves ``O.tags`` (a dict of strings) with the scene. Each engine keeps two 
   solver, options), pickled and base64-encoded; written when the engine is built;
 * ``yade_electro:<label>:state``: what changes every call (electrode values, thermal clock,
   energy ledger, fixed temperatures, the iteration and time of the last call, the number of
-  history rows), JSON; written at every call (about 30 us).
+  history rows), JSON; written at every call (about 30 us);
+* ``yade_electro:<label>:call``: with ``overlap=True``, the input of the call computed on the
+  worker thread and not yet published (pickled, base64), which a loaded scene replays.
 
 Temperatures are in ``b.state.temp`` (YADE's ThermalState), which YADE saves itself.
 """
@@ -19,7 +21,8 @@ import json
 import pickle
 from typing import Optional
 
-__all__ = ["PREFIX", "config_key", "state_key", "save_config", "load_config", "save_state", "load_state",
+__all__ = ["PREFIX", "config_key", "state_key", "call_key", "save_config", "load_config", "save_state", "load_state",
+           "save_call", "load_call",
            "saved_labels", "forget", "add_container", "scene_container"]
 
 PREFIX = "yade_electro"
@@ -62,6 +65,23 @@ def save_state(O, label: str, state: dict) -> None:
     _tags(O)[state_key(label)] = json.dumps(state)
 
 
+def call_key(label: str) -> str:
+    return f"{PREFIX}:{label}:call"
+
+
+def save_call(O, label: str, text: str) -> None:
+    """Store an overlapped engine's unpublished call (an ASCII string) in the scene: a tag
+    of its own, so the state's JSON stays small."""
+    _tags(O)[call_key(label)] = text
+
+
+def load_call(O, label: str) -> Optional[str]:
+    """The unpublished call saved under ``label``, or None."""
+    tags = _tags(O)
+    key = call_key(label)
+    return tags[key] if key in tags.keys() and tags[key] else None
+
+
 def load_state(O, label: str) -> Optional[dict]:
     """The state saved under ``label``, or None."""
     tags = _tags(O)
@@ -85,7 +105,7 @@ def saved_labels(O) -> list:
 def forget(O, label: str) -> None:
     """Clear an engine's tags in the scene (YADE's tags cannot be deleted: they are emptied)."""
     tags = _tags(O)
-    for key in (config_key(label), state_key(label)):
+    for key in (config_key(label), state_key(label), call_key(label)):
         if key in tags.keys():
             tags[key] = ""
 
