@@ -288,7 +288,8 @@ class _Engine:
 
     # -- one call ------------------------------------------------------------------------------
     def step(self):
-        """One call on the current scene (what the PyRunner calls)."""
+        """One call on the current scene (what the PyRunner calls); returns its history row
+        (None for an overlapped call: ``sync()`` returns it once computed)."""
         return self._guarded(self._step)
 
     def _guarded(self, fn):
