@@ -38,6 +38,7 @@ Run
 ---
     yade-electro -n -x cases/rotating_drum.py --rpm 20                # smooth wall
     yade-electro -n -x cases/rotating_drum.py --rpm 20 --baffles
+    yade-electro -n -x cases/rotating_drum.py --rpm 20 --overlap      # the engine's overlap=True
     yade-electro batch cases/rotating_drum.table cases/rotating_drum.py   # the 6 combinations
 """
 from __future__ import annotations
@@ -179,7 +180,8 @@ def lacey_index(pos, is_a, cell=8 * PARTICLE_RADIUS, min_count=5) -> float:
     return (s0 - s2) / (s0 - sr)
 
 
-def run(n=2000, rpm=20.0, baffles=False, duration=3.0, sample=0.1, seed=1, out="out/rotating_drum", verbose=True):
+def run(n=2000, rpm=20.0, baffles=False, duration=3.0, sample=0.1, seed=1, out="out/rotating_drum", verbose=True,
+        overlap=False):
     from yade_electro.yade.runtime import import_yade
     from yade_electro.vtk import write_bonds, write_elements
     yade = import_yade()
@@ -194,7 +196,7 @@ def run(n=2000, rpm=20.0, baffles=False, duration=3.0, sample=0.1, seed=1, out="
     wall = "baffles" if baffles else "smooth"
     tag = f"{int(rpm)}rpm_{wall}"
     os.makedirs(out, exist_ok=True)
-    engine = heat_engine(ids, hot, history=os.path.join(out, f"rotating_drum_{tag}.csv"))
+    engine = heat_engine(ids, hot, history=os.path.join(out, f"rotating_drum_{tag}.csv"), overlap=overlap)
     O.engines = O.engines + [engine.runner]
     start_rotation(ids, rpm)
     T_init = float(np.mean(engine.temperature))
@@ -236,7 +238,7 @@ def run(n=2000, rpm=20.0, baffles=False, duration=3.0, sample=0.1, seed=1, out="
            "final_lacey": samples[-1]["lacey"], "t90_wall_s": t90, "T_mean_final_K": float(Tm[-1]),
            "T_std_final_K": samples[-1]["T_std"], "wall_heat_J": wall_heat,
            "balance_rel": abs(stored - wall_heat) / max(abs(wall_heat), 1e-300),
-           "settle_s": round(t_settle, 1), "run_s": round(t_run, 1), "dt_s": float(O.dt),
+           "settle_s": round(t_settle, 1), "run_s": round(t_run, 1), "dt_s": float(O.dt), "overlap": overlap,
            "samples": samples, "png": png}
     engine.remove()
     return res
@@ -276,10 +278,13 @@ def main(argv=None):
     ap.add_argument("--sample", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="out/rotating_drum")
+    ap.add_argument("--overlap", action="store_true",
+                    help="the engine's overlap=True (its numpy work on a worker thread; the same results)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from caselib import apply_batch_table
     args = apply_batch_table(args, columns=("rpm", "baffles"))
-    res = run(args.n, args.rpm, bool(args.baffles), args.duration, args.sample, args.seed, args.out)
+    res = run(args.n, args.rpm, bool(args.baffles), args.duration, args.sample, args.seed, args.out,
+              overlap=args.overlap)
     with open(os.path.join(args.out, f"rotating_drum_{int(res['rpm'])}rpm_{res['wall']}.json"), "w") as fh:
         json.dump(res, fh)
     short = {k: v for k, v in res.items() if k != "samples"}

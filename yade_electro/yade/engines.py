@@ -776,6 +776,16 @@ class ElectroThermalEngine(ElectricalEngine):
         self._coupled = model
 
     @property
+    def reader(self):
+        """The engine's scene reader (after :meth:`sync`: its graph is the last call's)."""
+        self.sync()
+        return self._reader
+
+    @reader.setter
+    def reader(self, reader):
+        self._reader = reader
+
+    @property
     def history(self) -> History:
         """The engine's History (after :meth:`sync`: with the last call's row)."""
         self.sync()
