@@ -3,10 +3,10 @@
 adiabatic ends), one process, blocks with and without the engine interleaved.
 
 For each engine period (10 and 100 steps) and mode (``plain``: the default engine;
-``overlap``: ``overlap=True``, its numpy work on a worker thread) one engine is made and its first calls (the
-first Verlet list, the solver setup) run before the timing; then ``--pairs`` pairs of blocks
-of ``--steps`` steps each run, one with the engine alive and one with it dead (its PyRunner
-skipped), the order swapped every pair. Prints one JSON line per period and mode::
+``overlap``: ``overlap=True``, its numpy work on a worker thread) one engine is made and
+its first calls (the first Verlet list, the solver setup) run before the timing; then
+``--pairs`` pairs of blocks of ``--steps`` steps each run, one with the engine alive and
+one with it dead (its PyRunner skipped), the order swapped every pair. Prints one JSON line per period and mode::
 
     {"bench": "granular", "case": "drum", "n", "rpm", "period", "overlap", "skin",
      "ratio": wall_with / wall_without (sums over the blocks),

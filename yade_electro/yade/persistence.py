@@ -1,7 +1,8 @@
 """An engine's configuration and state, kept in the scene itself so that ``O.save`` /
 ``O.load`` carry them.
 
-YADE saves ``O.tags`` (a dict of strings) with the scene. Each engine keeps two tags:
+YADE saves ``O.tags`` (a dict of strings) with the scene. Each engine keeps two tags (three
+with ``overlap=True``):
 
 * ``yade_electro:<label>:config``: everything needed to build the engine again (materials,
   law and its reference geometry, electrode and boundary-condition membership *by body id*,
