@@ -316,3 +316,11 @@ def test_plot_history_from_csv_and_history(tmp_path):
         assert (tmp_path / "h.png").stat().st_size > 1000 and out.endswith("h.png")
     with pytest.raises(ValueError, match="no rows"):
         plot_history(History(), str(tmp_path / "x.png"))
+
+
+def test_overlap_warns_when_yade_leaves_no_core_free():
+    from yade_electro.yade.engines import overlap_competes
+    assert overlap_competes(1, 2) is None and overlap_competes(3, 8) is None
+    said = overlap_competes(2, 2)
+    assert said.startswith("overlap=True: YADE runs 2 thread(s) on 2 core(s)") and "yade -j 1" in said
+    assert overlap_competes(4, 2) is not None and overlap_competes(1, 1) is not None
