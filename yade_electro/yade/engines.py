@@ -1200,8 +1200,9 @@ def overlap_competes(yade_threads: int, cores: int) -> Optional[str]:
         return None
     return (f"overlap=True: YADE runs {yade_threads} thread(s) on {cores} core(s), so the engine's worker thread "
             "competes with YADE's own threads; measured on the drum with YADE on both cores of a 2-core machine, "
-            "it was slower than overlap=False (26 % of the wall time against 22 %). Leave a core free (yade -j "
-            f"{max(cores - 1, 1)}) or use overlap=False")
+            "it was slower than overlap=False (26 % of the wall time against 22 %). "
+            + (f"Leave a core free (yade -j {cores - 1}) or use overlap=False" if cores > 1
+               else "With one core, use overlap=False"))
 
 
 class _Work(NamedTuple):
