@@ -124,6 +124,15 @@ def _check_period(iterPeriod):
     return int(iterPeriod)
 
 
+def _synced(name: str, doc: str) -> property:
+    """A read-only attribute ``name`` read after ``self.sync()`` (``overlap=True``: the last
+    call is computed and published first; on the worker thread, as it is)."""
+    def get(self):
+        self.sync()
+        return getattr(self, name)
+    return property(get, doc=doc + " With overlap=True, reading it waits for the last call and publishes it.")
+
+
 class _Engine:
     """What both engines share: configuration, scene reader, runner, history, state tags."""
 
@@ -146,14 +155,14 @@ class _Engine:
         opts = dict(reader_options)
         skin, walls = opts.pop("skin", "auto"), opts.pop("walls", None)
         if opts["bonds"] == "contacts":
-            self.reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls,
-                                         periodic=self._heat_only)
+            self._reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls,
+                                          periodic=self._heat_only)
         else:
             if self._declared_walls:
                 raise BoundaryConditionError("walls (walls=, or electrodes with wall=) conduct in the granular mode "
                                              "only (bonds='contacts'): a bonded solid's boundaries are surfaces "
                                              "(surface=)")
-            self.reader = SceneReader(self.O, **opts)
+            self._reader = SceneReader(self.O, **opts)
         if history_mode not in ("w", "a", "x"):
             raise ValueError(f"history_mode must be 'w', 'a' or 'x', got {history_mode!r}")
         self.history_path = None if history is None else os.fspath(history)
@@ -205,7 +214,7 @@ class _Engine:
         check_write_back(self.write_back, self.reader.bodies)
         self._prepare(graph)                        # selections, structure: their errors here too
         mode = "a" if self._resume is not None else history_mode
-        self.history = History(self.history_path, mode)
+        self._history = History(self.history_path, mode)
         registry.check_shared_outputs(self)
         if self._resume is not None:
             self._restore_history(self._resume_state)
@@ -221,6 +230,16 @@ class _Engine:
         registry.ENGINES[self.label] = self
         self._save_config()
         self._save_state()
+
+    @property
+    def reader(self):
+        """The engine's scene reader (SceneReader, or GranularReader with ``bonds='contacts'``)."""
+        return self._reader
+
+    @property
+    def history(self) -> History:
+        """The engine's History (one row per call)."""
+        return self._history
 
     # -- persistence ---------------------------------------------------------------------------
     def _save_config(self):
@@ -298,7 +317,7 @@ class _Engine:
                 raise RuntimeError(f"engine {self.label!r} was removed")
             if in_mpy_subdomain():
                 raise RuntimeError(MPY_REFUSAL.format(label=self.label))
-            if self.reader.scene_replaced:
+            if self._reader.scene_replaced:
                 self._reattach_in_place()
             out = fn()
         except Exception as exc:
@@ -749,7 +768,7 @@ class ElectroThermalEngine(ElectricalEngine):
             extra.setdefault("law", law)
             extra.setdefault("law_params", self._law_params)
         extra.setdefault("container", self.container)
-        self.coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
+        self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
                                            eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
                                            sources=heat_sources, thermal_solver=thermal_solver,
                                            walls=[w for w, _ in wall_specs], **extra)
@@ -769,35 +788,9 @@ class ElectroThermalEngine(ElectricalEngine):
         self._finish(history_mode)
 
     # -- the model, and the overlapped call -----------------------------------------------
-    @property
-    def coupled(self) -> ElectroThermalModel:
-        """The engine's ElectroThermalModel (after :meth:`sync`: up to date with the last call)."""
-        self.sync()
-        return self._coupled
-
-    @coupled.setter
-    def coupled(self, model):
-        self._coupled = model
-
-    @property
-    def reader(self):
-        """The engine's scene reader (after :meth:`sync`: its graph is the last call's)."""
-        self.sync()
-        return self._reader
-
-    @reader.setter
-    def reader(self, reader):
-        self._reader = reader
-
-    @property
-    def history(self) -> History:
-        """The engine's History (after :meth:`sync`: with the last call's row)."""
-        self.sync()
-        return self._history
-
-    @history.setter
-    def history(self, history):
-        self._history = history
+    coupled = _synced("_coupled", "The engine's ElectroThermalModel (up to date with the last call).")
+    reader = _synced("_reader", "The engine's scene reader (its graph is the last call's).")
+    history = _synced("_history", "The engine's History (with the last call's row).")
 
     def sync(self) -> Optional[dict]:
         """With ``overlap=True``: wait for the last call's work on the worker thread and publish
@@ -817,12 +810,17 @@ class ElectroThermalEngine(ElectricalEngine):
             log.error("yade-electro engine %r failed in its overlapped call: %s: %s", self.label,
                       type(exc).__name__, exc)
             raise
-        self._temperature_writer.write(bodies, temperatures)
-        if self.plot:
-            self._plot_row(out)
+        self._publish(bodies, out, temperatures)
         if save:
             self._save_state()
         return out
+
+    def _publish(self, bodies, out, temperatures):
+        """An overlapped call's results to YADE: temperatures [K] to ``bodies``, its row to
+        ``yade.plot`` (the worker already wrote it to the history)."""
+        self._temperature_writer.write(bodies, temperatures)
+        if self.plot:
+            self._plot_row(out)
 
     def _drop_inflight(self):
         """Wait for a pending overlapped call and discard it (its scene was replaced)."""
@@ -975,7 +973,7 @@ class ElectroThermalEngine(ElectricalEngine):
         return kw
 
     def _save_state(self):
-        if self._inflight is not None and not getattr(_WORKER, "active", False):
+        if self._inflight is not None:
             state = dict(self._inflight_state)      # the model is the worker's now
             state["pending"] = {str(k): v for k, v in self._pending_temperatures.items()}
         else:
@@ -1075,9 +1073,9 @@ class ElectroThermalEngine(ElectricalEngine):
             self._resume_work(work)
         self._publish_inflight(save=False)         # the state saved below covers it
         state = self._state_dict()
-        work = _Work(self.reader.capture(), self._call_dt(), None, int(self.O.iter), float(self.O.time))
+        capture, dt = self.reader.capture(), self._call_dt()
         self._apply_materials()
-        work = work._replace(pending=self._pending_temperatures)
+        work = _Work(capture, dt, self._pending_temperatures, int(self.O.iter), float(self.O.time))
         self._pending_temperatures = {}
         self._last_time = work.mech_time
         state["pending"] = {}
@@ -1106,10 +1104,7 @@ class ElectroThermalEngine(ElectricalEngine):
                         "iteration %d is not replayed (the next call integrates its interval)", self.label,
                         work.iteration)
             return
-        out, temperatures = self._compute(work)
-        self._temperature_writer.write(self.reader.bodies, temperatures)
-        if self.plot:
-            self._plot_row(out)
+        self._publish(self._reader.bodies, *self._compute(work))
         self._last_time = work.mech_time
 
     @property
@@ -1212,7 +1207,7 @@ class _Work(NamedTuple):
 
     capture: Capture
     dt: float
-    pending: Optional[Dict[int, float]]
+    pending: Dict[int, float]
     iteration: int
     mech_time: float
 
