@@ -4,9 +4,11 @@ adiabatic ends), one process, blocks with and without the engine interleaved.
 
 For each engine period (10 and 100 steps) and mode (``plain``: the default engine;
 ``overlap``: ``overlap=True``, its numpy work on a worker thread) one engine is made and
-its first calls (the first Verlet list, the solver setup) run before the timing; then
-``--pairs`` pairs of blocks of ``--steps`` steps each run, one with the engine alive and
-one with it dead (its PyRunner skipped), the order swapped every pair. Prints one JSON line per period and mode::
+its first calls (the first Verlet list, the solver setup) run before the timing, and 20 more
+give its time per call; then ``--pairs`` groups of three blocks of ``--steps`` steps each
+run: one with the engine alive, one with it dead (its PyRunner skipped) and one with the
+engine dead and a stand-in alive that only sleeps that time per call, the order reversed
+every group. Prints one JSON line per period and mode::
 
     {"bench": "granular", "case": "drum", "n", "rpm", "period", "overlap", "skin",
      "ratio": wall_with / wall_without (sums over the blocks),
@@ -21,13 +23,19 @@ one with it dead (its PyRunner skipped), the order swapped every pair. Prints on
      "yade_engines_ms_with", "yade_engines_ms_without": the time per step inside YADE's own
          engines (their ``execTime``, ``O.timingEnabled``) with the engine alive and dead: how
          much the engine's calls slow YADE's own work down between them,
-     "load"}
+     "pause_ms", "pause_share", "pause_share_of_sums", "yade_engines_ms_pause": the same for a
+         stand-in timed in the same groups of blocks: a PyRunner at the engine's period that
+         only sleeps for the engine's own mean time per call (the 20 warm-up calls, then all
+         its timed calls so far), no work and no memory touched. Its share is what any engine
+         that stops YADE's loop that long costs on this machine,
+     "block_timer": how the blocks were timed (:func:`_benchlib.run_steps`), "load"}
 
     yade-electro -n -x bench/bench_granular.py [--n 2000] [--steps 100] [--pairs 40] [--modes plain,overlap]
 """
 from __future__ import annotations
 
 import argparse
+import builtins
 import json
 import os
 import sys
@@ -37,7 +45,7 @@ _SCRIPT = __file__ if __file__.endswith("bench_granular.py") else (
     sys.argv[0] if sys.argv and sys.argv[0].endswith("bench_granular.py") else __file__)
 HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 sys.path.insert(0, HERE)
-import _benchlib  # noqa: E402,F401  (puts the project and cases/ on the path)
+import _benchlib  # noqa: E402  (puts the project and cases/ on the path; run_steps)
 
 
 def main(argv=None):
@@ -80,7 +88,21 @@ def main(argv=None):
         O.engines = O.engines + [engine.runner]
         O.run(max(2 * period, args.steps), True)      # first calls and the skin's adaptation out of the blocks
         inner = engine._step
-        spent = [0.0]
+        spent = [0.0, 0]        # seconds inside the timed calls, their count
+        warm = []
+
+        def warm_timed(*a, **k):
+            t_ = time.perf_counter()
+            try:
+                return inner(*a, **k)
+            finally:
+                warm.append(time.perf_counter() - t_)
+        engine._step = warm_timed
+        O.run(20 * period, True)                      # the engine's time per call, for the stand-in
+        builtins._bench_granular_pause = float(np.mean(warm))
+        sleeper = yade.PyRunner(command="__import__('time').sleep(__import__('builtins')._bench_granular_pause)",
+                                iterPeriod=period, dead=True)
+        O.engines = O.engines + [sleeper]
 
         def timed(*a, **k):
             t_ = time.perf_counter()
@@ -88,25 +110,30 @@ def main(argv=None):
                 return inner(*a, **k)
             finally:
                 spent[0] += time.perf_counter() - t_
+                spent[1] += 1
         engine._step = timed
         c0, b0 = engine.reader.calls, engine.reader.list_builds
-        wall = {"with": 0.0, "without": 0.0}
-        own = {"with": 0.0, "without": 0.0}         # YADE's own engines (execTime, ns)
+        wall = {"with": 0.0, "without": 0.0, "pause": 0.0}
+        own = {"with": 0.0, "without": 0.0, "pause": 0.0}         # YADE's own engines (execTime, ns)
         mechanics = [e for e in O.engines if type(e).__name__ != "PyRunner"]
         O.timingEnabled = True
-        pair_ratios = []
+        pair_ratios, pause_ratios = [], []
         for k in range(args.pairs):
             w = {}
-            for mode in (("without", "with") if k % 2 == 0 else ("with", "without")):
-                engine.runner.dead = mode == "without"
+            for mode in (("without", "with", "pause") if k % 2 == 0 else ("pause", "with", "without")):
+                engine.runner.dead = mode != "with"
+                sleeper.dead = mode != "pause"
                 e0 = sum(e.execTime for e in mechanics)
-                t = time.perf_counter()
-                O.run(args.steps, True)
-                w[mode] = time.perf_counter() - t
+                w[mode] = _benchlib.run_steps(O, args.steps)
                 own[mode] += sum(e.execTime for e in mechanics) - e0
                 wall[mode] += w[mode]
             pair_ratios.append(w["with"] / w["without"])
+            pause_ratios.append(w["pause"] / w["without"])
+            # the stand-in sleeps the engine's mean call so far
+            builtins._bench_granular_pause = (sum(warm) + spent[0]) / (len(warm) + spent[1])
         O.timingEnabled = False
+        sleeper.dead = True
+        O.engines = [e for e in O.engines if e is not sleeper]
         engine.sync()
         calls = engine.reader.calls - c0
         builds = engine.reader.list_builds - b0
@@ -122,7 +149,11 @@ def main(argv=None):
                "list_builds_per_call": round(builds / max(calls, 1), 3),
                "yade_engines_ms_with": round(1e-6 * own["with"] / (args.pairs * args.steps), 3),
                "yade_engines_ms_without": round(1e-6 * own["without"] / (args.pairs * args.steps), 3),
-               "load": round(os.getloadavg()[0], 2)}
+               "pause_ms": round(1e3 * builtins._bench_granular_pause, 3),
+               "pause_share": round(1.0 - 1.0 / float(np.median(pause_ratios)), 3),
+               "pause_share_of_sums": round(1.0 - wall["without"] / wall["pause"], 3),
+               "yade_engines_ms_pause": round(1e-6 * own["pause"] / (args.pairs * args.steps), 3),
+               "block_timer": _benchlib.BLOCK_TIMER, "load": round(os.getloadavg()[0], 2)}
         out.append(row)
         print(json.dumps(row), flush=True)
     return out
@@ -138,13 +169,27 @@ def reference_rows(yade, O, args):
     """Stand-ins for the engine, every 10 steps, blocks interleaved with dead ones as for the
     engine: ``spin`` (a 6 ms pure-Python loop), ``alloc`` (numpy sums a fresh 16 MB array)
     and ``sleep`` (``time.sleep(0.006)``: no work, no memory touched, only a pause of YADE's
-    loop). One JSON line each: the time per step in YADE's own engines alive and dead; then
-    :func:`pause_decay`'s line."""
-    import builtins
+    loop); and two that hand their work to a worker thread as ``overlap=True`` does, so that
+    YADE's loop goes on at once: ``thread_spin`` (a 2 ms pure-Python loop on the thread) and
+    ``thread_sleep`` (a 2 ms sleep on the thread: the hand-over alone). One JSON line each:
+    the time per step in YADE's own engines alive and dead; then :func:`pause_decay`'s line."""
+    from concurrent.futures import ThreadPoolExecutor
+    pool, pending = ThreadPoolExecutor(max_workers=1), []
+
+    def on_thread(job):
+        while pending:
+            pending.pop().result()
+        pending.append(pool.submit(job))
     builtins._bench_granular_spin = _spin
+    builtins._bench_granular_thread = {"spin": lambda: on_thread(lambda: _spin(2.0)),
+                                       "sleep": lambda: on_thread(lambda: time.sleep(0.002))}
     runners = {"spin": yade.PyRunner(command="__import__('builtins')._bench_granular_spin(6.0)", iterPeriod=10),
                "alloc": yade.PyRunner(command="__import__('numpy').random.rand(2000000).sum()", iterPeriod=10),
-               "sleep": yade.PyRunner(command="__import__('time').sleep(0.006)", iterPeriod=10)}
+               "sleep": yade.PyRunner(command="__import__('time').sleep(0.006)", iterPeriod=10),
+               "thread_spin": yade.PyRunner(command="__import__('builtins')._bench_granular_thread['spin']()",
+                                            iterPeriod=10),
+               "thread_sleep": yade.PyRunner(command="__import__('builtins')._bench_granular_thread['sleep']()",
+                                             iterPeriod=10)}
     O.engines = O.engines + list(runners.values())
     mechanics = [e for e in O.engines if type(e).__name__ != "PyRunner"]
     O.timingEnabled = True
@@ -154,12 +199,14 @@ def reference_rows(yade, O, args):
         for mode in (modes if k % 2 == 0 else modes[::-1]):
             for name, r in runners.items():
                 r.dead = name != mode
-            e0, t = sum(e.execTime for e in mechanics), time.perf_counter()
-            O.run(args.steps, True)
-            wall[mode] = wall.get(mode, 0.0) + time.perf_counter() - t
+            e0 = sum(e.execTime for e in mechanics)
+            wall[mode] = wall.get(mode, 0.0) + _benchlib.run_steps(O, args.steps)
             own[mode] = own.get(mode, 0.0) + sum(e.execTime for e in mechanics) - e0
     O.timingEnabled = False
     O.engines = [e for e in O.engines if e not in runners.values()]
+    while pending:
+        pending.pop().result()
+    pool.shutdown()
     steps = args.pairs * args.steps
     rows = []
     for name in runners:
@@ -168,7 +215,7 @@ def reference_rows(yade, O, args):
                "yade_engines_ms_with": round(1e-6 * own[name] / steps, 3),
                "yade_engines_ms_without": round(1e-6 * own["dead"] / steps, 3),
                "yade_engines_slowdown": round(own[name] / own["dead"] - 1.0, 3),
-               "load": round(os.getloadavg()[0], 2)}
+               "block_timer": _benchlib.BLOCK_TIMER, "load": round(os.getloadavg()[0], 2)}
         rows.append(row)
         print(json.dumps(row), flush=True)
     rows.append(pause_decay(O, args.pairs))

@@ -3,7 +3,8 @@ every step), engine and no-engine blocks interleaved in one process.
 
 For each size (the rod case's bonded packings, seed 1) and configuration (ElectricalEngine
 every step and every 100 steps, ElectroThermalEngine every 100 steps; 'continuum' and, at the
-first size, 'voronoi'), the same simulation runs in alternating blocks of about half a second:
+first size, 'voronoi'), the same simulation runs in alternating blocks (80 steps with the engine every step, 500 every
+100 steps at up to 5,000 elements; 20 and 200 above; at 5,000 about 1 s and 6 s on this machine):
 ``--blocks`` pairs, one block without the engine and one with it (its PyRunner made dead or
 alive), the order swapped every pair. At the end a bond is broken in shear and the call that
 finds it is timed (``bond_break_call_ms``).
@@ -20,7 +21,7 @@ One JSON line per configuration::
      "positions_read_ms": median call that read the positions and found no move beyond the
      tolerance, "median_call_ms", "max_call_ms" (a call that moved the values: new geometry,
      warm re-solve, write-back), "max_over_unchanged", "max_over_positions_read", "calls",
-     "calls_by_kind", "structure_builds", "mech_step_ms", "load_average"}
+     "calls_by_kind", "structure_builds", "mech_step_ms", "block_timer", "load_average"}
 
     yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4] [--only engine/law/period,...]
 """
@@ -40,7 +41,7 @@ sys.path.insert(0, HERE)
 
 import numpy as np  # noqa: E402
 
-from _benchlib import bonded_rod  # noqa: E402
+from _benchlib import BLOCK_TIMER, bonded_rod, run_steps  # noqa: E402
 
 STRAIN = 1e-4
 
@@ -110,9 +111,7 @@ def bench(n, kind, law, period, steps, blocks):
         w = {}
         for mode in (("without", "with") if b % 2 == 0 else ("with", "without")):
             engine.runner.dead = mode == "without"
-            t = time.perf_counter()
-            O.run(steps, True)
-            w[mode] = time.perf_counter() - t
+            w[mode] = run_steps(O, steps)
             wall[mode] += w[mode]
         pair_ratios.append(w["with"] / w["without"])
     # a bond broken in shear (its spheres stay together: only the sweep sees it): the call
@@ -150,7 +149,7 @@ def bench(n, kind, law, period, steps, blocks):
            "structure_builds": int(engine.model.updates["structure"]) if engine.model else None,
            "steps_per_block": int(steps), "blocks": int(blocks),
            "mech_step_ms": round(1e3 * wall["without"] / (blocks * steps), 3),
-           "load_average": round(os.getloadavg()[0], 2)}
+           "block_timer": BLOCK_TIMER, "load_average": round(os.getloadavg()[0], 2)}
     engine.remove()
     registry.ENGINES.pop(engine.label, None)
     print(json.dumps(row), flush=True)

@@ -10,7 +10,7 @@ One JSON line per (law, period)::
 
     {"bench": "pin", "n", "law", "period", "engine_share": time in the engine / wall of the
      blocks with it, "ratio": wall with / wall without, "step_ms_without", "step_ms_with",
-     "moment_check_share": the moment-strength check's share (it runs in both), "load_average"}
+     "moment_check_share": the moment-strength check's share (it runs in both), "block_timer", "load_average"}
 
     yade-electro -n -x bench/bench_pin.py [--n 5000] [--block 400] [--blocks 3]
 """
@@ -20,12 +20,12 @@ import argparse
 import json
 import os
 import sys
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__ if __file__.endswith("bench_pin.py") else sys.argv[0]))
-for _p in (os.path.dirname(HERE), os.path.join(os.path.dirname(HERE), "cases")):
+for _p in (os.path.dirname(HERE), os.path.join(os.path.dirname(HERE), "cases"), HERE):
     if _p not in sys.path:
         sys.path.insert(0, _p)
+from _benchlib import BLOCK_TIMER, run_steps  # noqa: E402
 
 
 def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block=400, blocks=3):
@@ -52,16 +52,14 @@ def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block
             for k in range(blocks):
                 for alive in ((True, False) if k % 2 == 0 else (False, True)):
                     eng.runner.dead = not alive
-                    t = time.perf_counter()
-                    O.run(block, True)
-                    wall[alive] += time.perf_counter() - t
+                    wall[alive] += run_steps(O, block)
                     steps[alive] += block
             row = {"bench": "pin", "n": len(pin["ids"]), "law": law, "period": period,
                    "engine_share": eng.runner.execTime * 1e-9 / wall[True], "ratio": wall[True] / wall[False],
                    "step_ms_without": 1e3 * wall[False] / steps[False], "step_ms_with": 1e3 * wall[True] / steps[True],
                    "moment_check_share": check.execTime * 1e-9 / (wall[True] + wall[False]),
                    "theta_end": pin["rig"].theta, "broken": int(pin["strength_check"].broken),
-                   "load_average": os.getloadavg()[0]}
+                   "block_timer": BLOCK_TIMER, "load_average": os.getloadavg()[0]}
             print(json.dumps(row), flush=True)
             out.append(row)
             eng.remove()
