@@ -28,7 +28,6 @@ it), and ``engine = yade_electro.yade.attach(label)`` gives back a handle.
 """
 from __future__ import annotations
 
-import base64
 import dataclasses
 import logging
 import os
@@ -783,8 +782,8 @@ class ElectroThermalEngine(ElectricalEngine):
             self.coupled.restore_temperatures(self._read_temperatures)
             self._pending_temperatures = {int(k): float(v) for k, v in (st.get("pending") or {}).items()}
             saved_call = persistence.load_call(self.O, self.label) if st.get("overlap_iter") is not None else None
-            if saved_call:
-                self._resumed_work = _decode_work(saved_call)
+            if saved_call is not None:
+                self._resumed_work = _Work.saved(saved_call)
         self._finish(history_mode)
 
     # -- the model, and the overlapped call -----------------------------------------------
@@ -1080,7 +1079,7 @@ class ElectroThermalEngine(ElectricalEngine):
         self._last_time = work.mech_time
         state["pending"] = {}
         state["overlap_iter"] = work.iteration
-        persistence.save_call(self.O, self.label, _encode_work(work))
+        persistence.save_call(self.O, self.label, tuple(work))
         self._inflight_state = state
         self._inflight = (self._executor().submit(self._compute, work), self.reader.bodies)
         return None             # (_guarded saves the state)
@@ -1211,14 +1210,11 @@ class _Work(NamedTuple):
     iteration: int
     mech_time: float
 
-
-def _encode_work(work: _Work) -> str:
-    return base64.b64encode(pickle.dumps(tuple(work), protocol=4)).decode("ascii")
-
-
-def _decode_work(text: str) -> _Work:
-    capture, dt, pending, iteration, mech_time = pickle.loads(base64.b64decode(text.encode("ascii")))
-    return _Work(Capture(*capture), float(dt), dict(pending or {}), int(iteration), float(mech_time))
+    @classmethod
+    def saved(cls, data) -> "_Work":
+        """The call of ``tuple(work)`` as :func:`persistence.load_call` gives it back."""
+        capture, dt, pending, iteration, mech_time = data
+        return cls(Capture(*capture), float(dt), dict(pending or {}), int(iteration), float(mech_time))
 
 
 def engine_class(name: str):

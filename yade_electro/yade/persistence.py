@@ -41,24 +41,35 @@ def _tags(O):
     return O.tags
 
 
+def _tag(O, key: str) -> Optional[str]:
+    """The text of tag ``key``, or None when it is missing or emptied (:func:`forget`)."""
+    tags = _tags(O)
+    return tags[key] if key in tags.keys() and tags[key] else None
+
+
+def _pickled(obj) -> str:
+    """``obj`` pickled and base64-encoded (ASCII: a YADE tag survives .xml and binary saves)."""
+    return base64.b64encode(pickle.dumps(obj, protocol=4)).decode("ascii")
+
+
+def _unpickled(text: Optional[str]):
+    return None if text is None else pickle.loads(base64.b64decode(text.encode("ascii")))
+
+
 def save_config(O, label: str, config: dict) -> None:
     """Store an engine's configuration in the scene (pickled; raises TypeError with the name
     of the part that cannot be pickled)."""
     try:
-        blob = pickle.dumps(config, protocol=4)
+        text = _pickled(config)
     except Exception as exc:
         raise TypeError(f"the configuration of engine {label!r} cannot be saved with the scene ({exc}); "
                         "give selectors, containers and options as plain data or YADE predicates") from None
-    _tags(O)[config_key(label)] = base64.b64encode(blob).decode("ascii")
+    _tags(O)[config_key(label)] = text
 
 
 def load_config(O, label: str) -> Optional[dict]:
     """The configuration saved under ``label``, or None."""
-    tags = _tags(O)
-    key = config_key(label)
-    if key not in tags.keys() or not tags[key]:
-        return None
-    return pickle.loads(base64.b64decode(tags[key].encode("ascii")))
+    return _unpickled(_tag(O, config_key(label)))
 
 
 def save_state(O, label: str, state: dict) -> None:
@@ -70,26 +81,21 @@ def call_key(label: str) -> str:
     return f"{PREFIX}:{label}:call"
 
 
-def save_call(O, label: str, text: str) -> None:
-    """Store an overlapped engine's unpublished call (an ASCII string) in the scene: a tag
-    of its own, so the state's JSON stays small."""
-    _tags(O)[call_key(label)] = text
+def save_call(O, label: str, call) -> None:
+    """Store an overlapped engine's unpublished call (plain data: it is pickled) in the
+    scene: a tag of its own, so the state's JSON stays small."""
+    _tags(O)[call_key(label)] = _pickled(call)
 
 
-def load_call(O, label: str) -> Optional[str]:
+def load_call(O, label: str):
     """The unpublished call saved under ``label``, or None."""
-    tags = _tags(O)
-    key = call_key(label)
-    return tags[key] if key in tags.keys() and tags[key] else None
+    return _unpickled(_tag(O, call_key(label)))
 
 
 def load_state(O, label: str) -> Optional[dict]:
     """The state saved under ``label``, or None."""
-    tags = _tags(O)
-    key = state_key(label)
-    if key not in tags.keys() or not tags[key]:
-        return None
-    return json.loads(tags[key])
+    text = _tag(O, state_key(label))
+    return None if text is None else json.loads(text)
 
 
 def saved_labels(O) -> list:
