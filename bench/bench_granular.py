@@ -88,30 +88,21 @@ def main(argv=None):
         O.engines = O.engines + [engine.runner]
         O.run(max(2 * period, args.steps), True)      # first calls and the skin's adaptation out of the blocks
         inner = engine._step
-        spent = [0.0, 0]        # seconds inside the timed calls, their count
-        warm = []
-
-        def warm_timed(*a, **k):
-            t_ = time.perf_counter()
-            try:
-                return inner(*a, **k)
-            finally:
-                warm.append(time.perf_counter() - t_)
-        engine._step = warm_timed
-        O.run(20 * period, True)                      # the engine's time per call, for the stand-in
-        builtins._bench_granular_pause = float(np.mean(warm))
-        sleeper = yade.PyRunner(command="__import__('time').sleep(__import__('builtins')._bench_granular_pause)",
-                                iterPeriod=period, dead=True)
-        O.engines = O.engines + [sleeper]
+        call_s = []             # each call's time inside the engine [s]: 20 warm-up calls, then the timed ones
 
         def timed(*a, **k):
             t_ = time.perf_counter()
             try:
                 return inner(*a, **k)
             finally:
-                spent[0] += time.perf_counter() - t_
-                spent[1] += 1
+                call_s.append(time.perf_counter() - t_)
         engine._step = timed
+        O.run(20 * period, True)                      # the engine's time per call, for the stand-in
+        warm = len(call_s)
+        builtins._bench_granular_pause = float(np.mean(call_s))
+        sleeper = yade.PyRunner(command="__import__('time').sleep(__import__('builtins')._bench_granular_pause)",
+                                iterPeriod=period, dead=True)
+        O.engines = O.engines + [sleeper]
         c0, b0 = engine.reader.calls, engine.reader.list_builds
         wall = {"with": 0.0, "without": 0.0, "pause": 0.0}
         own = {"with": 0.0, "without": 0.0, "pause": 0.0}         # YADE's own engines (execTime, ns)
@@ -129,12 +120,12 @@ def main(argv=None):
                 wall[mode] += w[mode]
             pair_ratios.append(w["with"] / w["without"])
             pause_ratios.append(w["pause"] / w["without"])
-            # the stand-in sleeps the engine's mean call so far
-            builtins._bench_granular_pause = (sum(warm) + spent[0]) / (len(warm) + spent[1])
+            builtins._bench_granular_pause = float(np.mean(call_s))    # the engine's mean call so far
         O.timingEnabled = False
         sleeper.dead = True
         O.engines = [e for e in O.engines if e is not sleeper]
         engine.sync()
+        spent = sum(call_s[warm:])
         calls = engine.reader.calls - c0
         builds = engine.reader.list_builds - b0
         engine.remove()
@@ -143,8 +134,8 @@ def main(argv=None):
                "overlap": mode_name == "overlap",
                "skin": engine.reader.skin, "ratio": round(ratio, 3), "ratio_median_of_pairs": round(med, 3),
                "engine_share": round(1.0 - 1.0 / med, 3), "engine_share_of_sums": round(1.0 - 1.0 / ratio, 3),
-               "calls_share": round(spent[0] / wall["with"], 3),
-               "call_ms": round(1e3 * spent[0] / max(calls, 1), 3),
+               "calls_share": round(spent / wall["with"], 3),
+               "call_ms": round(1e3 * spent / max(calls, 1), 3),
                "yade_step_ms": round(1e3 * wall["without"] / (args.pairs * args.steps), 3),
                "list_builds_per_call": round(builds / max(calls, 1), 3),
                "yade_engines_ms_with": round(1e-6 * own["with"] / (args.pairs * args.steps), 3),
