@@ -20,7 +20,9 @@ One JSON line per configuration::
      "unchanged_ms": median call that read nothing (no position read, nothing changed),
      "positions_read_ms": median call that read the positions and found no move beyond the
      tolerance, "median_call_ms", "max_call_ms" (a call that moved the values: new geometry,
-     warm re-solve, write-back), "max_over_unchanged", "max_over_positions_read", "calls",
+     warm re-solve, write-back), "max_over_unchanged", "geometry_median_ms" and
+     "geometry_median_over_unchanged" (the median of the calls that found moves: the typical
+     such call, where the largest is one sample), "max_over_positions_read", "calls",
      "calls_by_kind", "structure_builds", "mech_step_ms", "block_timer", "load_average"}
 
     yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4] [--only engine/law/period,...]
@@ -129,6 +131,7 @@ def bench(n, kind, law, period, steps, blocks):
     t_all = np.array(times)
     unchanged = t_all[np.array(kinds) == "unchanged"]
     read_only = t_all[np.array(kinds) == "positions read"]
+    geometry = t_all[np.array(kinds) == "geometry"]
     first = t_all[0] if len(t_all) else float("nan")
     um = float(np.median(unchanged)) if unchanged.size else float("nan")
     rest = t_all[1:]
@@ -142,6 +145,9 @@ def bench(n, kind, law, period, steps, blocks):
            "median_call_ms": round(1e3 * float(np.median(rest)), 3) if rest.size else None,
            "max_call_ms": round(1e3 * float(rest.max()), 3) if rest.size else None,
            "max_over_unchanged": round(float(rest.max()) / um, 2) if rest.size and um > 0 else None,
+           "geometry_median_ms": round(1e3 * float(np.median(geometry)), 3) if geometry.size else None,
+           "geometry_median_over_unchanged": round(float(np.median(geometry)) / um, 2)
+           if geometry.size and um > 0 else None,
            "positions_read_ms": round(1e3 * float(np.median(read_only)), 3) if read_only.size else None,
            "max_over_positions_read": round(float(rest.max()) / float(np.median(read_only)), 2)
            if rest.size and read_only.size else None,
