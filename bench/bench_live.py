@@ -26,6 +26,10 @@ One JSON line per configuration::
      "calls_by_kind", "structure_builds", "mech_step_ms", "block_timer", "load_average"}
 
     yade-electro -n -x bench/bench_live.py [--sizes 5000,20000] [--blocks 4] [--only engine/law/period,...]
+
+Before the configurations of each size, one line ``{"bench": "live_positions_read", ...}``
+(:func:`positions_read`): what reading the positions costs, YADE's reader alone and with
+either conversion to numpy.
 """
 from __future__ import annotations
 
@@ -162,6 +166,39 @@ def bench(n, kind, law, period, steps, blocks):
     return row
 
 
+def positions_read(n, repeats=30):
+    """What reading every body's centre costs on the bonded rod of ``n`` elements, interleaved
+    in one process (medians of ``repeats``): YADE's bulk reader alone (``api_ms``: the three
+    ``coordsAndDisplacements`` calls), the engines' read (``array_ms``:
+    :func:`yade_electro.yade.scene.bulk_coordinates`, the lists through ``array.array``) and
+    the same read with ``numpy.fromiter`` instead (``fromiter_ms``, the read before)."""
+    from yade import utils as U
+    from yade_electro.yade.scene import bulk_coordinates
+    O, ids, _, _ = bonded_rod(n)
+    n_bodies = len(O.bodies)
+
+    def api():
+        return [U.coordsAndDisplacements(k)[0] for k in range(3)]
+
+    def fromiter():
+        return np.column_stack([np.fromiter(c, dtype=float, count=len(c)) for c in api()])
+
+    reads = {"api": api, "array": lambda: bulk_coordinates(n_bodies), "fromiter": fromiter}
+    if not np.array_equal(reads["array"](), fromiter()):
+        raise RuntimeError("the two conversions of the positions differ")
+    times = {name: [] for name in reads}
+    for k in range(repeats):
+        for name in (list(reads) if k % 2 == 0 else list(reads)[::-1]):
+            t = time.perf_counter()
+            reads[name]()
+            times[name].append(time.perf_counter() - t)
+    row = {"bench": "live_positions_read", "n": int(len(ids)), "bodies": n_bodies, "repeats": repeats,
+           **{f"{name}_ms": round(1e3 * float(np.median(v)), 3) for name, v in times.items()},
+           "load_average": round(os.getloadavg()[0], 2)}
+    print(json.dumps(row), flush=True)
+    return row
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser()
     ap.add_argument("--sizes", default="5000,20000")
@@ -174,6 +211,7 @@ def main(argv=None):
     for k, n in enumerate(int(x) for x in args.sizes.split(",")):
         # blocks of about half a second of mechanics, short so that the machine's noise
         # falls alike on both kinds of block
+        rows.append(positions_read(n))
         steps_1, steps_100 = (80, 500) if n <= 5000 else (20, 200)
         configs = [("ElectricalEngine", "continuum", 1, steps_1),
                    ("ElectricalEngine", "continuum", 100, steps_100),

@@ -164,10 +164,10 @@ def bulk_coordinates(n_existing: int) -> np.ndarray:
     ``utils.coordsAndDisplacements`` (rows as ``SphereBodies.slot_of``); GraphError when the
     body count is no longer ``n_existing``.
 
-    The lists of Python floats go to numpy through ``array.array('d', ...)``: measured in one
-    process (YADE's rods, interleaved, medians of 30), the whole read took 0.98 against 1.10
-    ms with ``numpy.fromiter`` at 5,000 bodies and 5.36 against 6.01 ms at 20,000; YADE's
-    three calls alone take 0.65 and 3.9 ms."""
+    The lists of Python floats go to numpy through ``array.array('d', ...)``, about 10 % of the
+    read faster than ``numpy.fromiter`` (``bench/bench_live.py``'s ``live_positions_read``
+    lines: 0.93 against 1.04 ms at 5,000 bodies, 4.41 against 4.73 ms at 20,000; YADE's three
+    calls alone 0.62 and 3.0 ms)."""
     U = import_yade().utils
     cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
     if len(cols[0]) != n_existing:
