@@ -50,9 +50,9 @@ WARMUP = 10         # steps before the timed ones: a live run's steady state, wh
 
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
-    from yade_electro.coupled import ElectroThermalModel
-    from yade_electro.electrical import ElectricalModel
-    from yade_electro.geometry import Cylinder
+    from yade_electro.physics.coupled import ElectroThermalModel
+    from yade_electro.physics.electrical import ElectricalModel
+    from yade_electro.geometry.shapes import Cylinder
     from yade_electro.yade import ElectroThermalEngine, SceneReader
     import joule_rod as jr
     import rod_resistance as rod

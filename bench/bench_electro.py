@@ -30,8 +30,9 @@ from yade_electro.yade.runtime import import_yade  # noqa: E402
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade import pack
-    from yade_electro.conductance import conductance
-    from yade_electro.network import ConductionProblem, Electrode
+    from yade_electro.laws.conductance import conductance
+    from yade_electro.network.conduction import ConductionProblem
+    from yade_electro.network.kirchhoff import Electrode
     from yade_electro.yade import SceneReader
     from yade_electro.yade import packing as P
     import rod_resistance as rod
@@ -61,8 +62,8 @@ def bench_size(n, repeat=5, seed=1):
 
     # the continuum law's factors after a move (a new graph object: nothing cached), compiled
     # and numpy, interleaved
-    import yade_electro.contacts as contacts
-    from yade_electro.conductance import make_law
+    import yade_electro.geometry.contacts as contacts
+    from yade_electro.laws.conductance import make_law
     law = make_law("continuum")
     times = {True: [], False: []}
     for rep in range(4 * repeat):
@@ -93,7 +94,7 @@ def bench_size(n, repeat=5, seed=1):
 
     # the 'voronoi' law: its first solve (one bounded tessellation: faces, cell volumes and
     # boundary faces), then the update after a bond broke (the structure is kept)
-    from yade_electro.electrical import ElectricalModel
+    from yade_electro.physics.electrical import ElectricalModel
     el = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
           "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
     model = ElectricalModel(rod.RHO_304L, el, law="voronoi",

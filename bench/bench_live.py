@@ -66,7 +66,7 @@ def make_engine(kind, law, period, ids, top, bottom):
     import joule_rod as jr
     import rod_resistance as rod
     from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
-    from yade_electro.geometry import Cylinder
+    from yade_electro.geometry.shapes import Cylinder
     el = {"top": dict(select=ids[top], potential=1.0), "bottom": dict(select=ids[bottom], potential=0.0)}
     lp = {"container": Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)} if law == "voronoi" else None
     if kind == "ElectricalEngine":

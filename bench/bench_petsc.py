@@ -35,9 +35,9 @@ def log(msg):
 
 def worker(sizes):
     from bench_scale import RADIUS, jittered_rod, reduced_rod_system
-    from yade_electro.conductance import conductance
-    from yade_electro.petsc_solver import PETScSolver, import_petsc
-    from yade_electro.solvers import make_solver
+    from yade_electro.laws.conductance import conductance
+    from yade_electro.solvers.petsc import PETScSolver, import_petsc
+    from yade_electro.solvers.registry import make_solver
     PETSc = import_petsc()
     comm = PETSc.COMM_WORLD
     rank, size = comm.getRank(), comm.getSize()

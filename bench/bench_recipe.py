@@ -27,7 +27,7 @@ LENGTH, RADIUS = 5e-3, 1e-3     # m, the rod case's
 
 def recipe(n: int, seed: int = 1) -> dict:
     import yade
-    from yade_electro.geometry import Cylinder
+    from yade_electro.geometry.shapes import Cylinder
     from yade_electro.yade import packing as P
     O = yade.Omega()
     t0 = time.perf_counter()

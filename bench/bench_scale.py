@@ -85,7 +85,7 @@ def eigen_driver() -> str:
 
 def jittered_rod(n, seed=1):
     """(graph, top nodes, bottom nodes) of a rod of about n spheres (m x m x 4m)."""
-    from yade_electro.graph import ContactGraph
+    from yade_electro.core.graph import ContactGraph
     m = max(3, int(round((n / 4.0) ** (1.0 / 3.0))))
     shape = (m, m, 4 * m)
     k, j, i = np.meshgrid(np.arange(shape[2]), np.arange(shape[1]), np.arange(shape[0]), indexing="ij")
@@ -105,7 +105,7 @@ def jittered_rod(n, seed=1):
 def reduced_rod_system(g, top, bottom, c):
     """The reduced system of the rod with ``top`` at 1 V and ``bottom`` at 0 V: (ReducedSystem,
     K_uu, K_ud, b = -K_ud u_d, coordinates of the unknowns)."""
-    from yade_electro.condensation import ReducedSystem
+    from yade_electro.network.condensation import ReducedSystem
     rs = ReducedSystem(g.n_nodes, g.edges, [top, bottom])
     Kuu, Kud = rs.assemble(c)
     return rs, Kuu, Kud, -(Kud @ np.array([1.0, 0.0])), g.pos[rs.unknown_nodes]
@@ -130,9 +130,10 @@ def run_eigen(exe, path):
 
 
 def bench_size(n, repeat, exe, tmp):
-    from yade_electro.conductance import conductance
-    from yade_electro.network import ConductionProblem, Electrode
-    from yade_electro.solvers import auto_solver_name, make_solver
+    from yade_electro.laws.conductance import conductance
+    from yade_electro.network.conduction import ConductionProblem
+    from yade_electro.network.kirchhoff import Electrode
+    from yade_electro.solvers.registry import auto_solver_name, make_solver
     row = {"bench": "scale", "law": "continuum"}
     st = {}
     t = time.perf_counter()
@@ -212,10 +213,11 @@ def bench_voronoi(n):
     """The ``voronoi`` law's pipeline on the rod of about n elements in its box: graph,
     tessellation (bounded cells, faces, the conducting network), conductances, the cold
     ConductionProblem solve, Joule heat. Run in a process of its own (peak RSS per size)."""
-    from yade_electro.conductance import make_law
-    from yade_electro.geometry import Box
-    from yade_electro.network import ConductionProblem, Electrode
-    from yade_electro.tessellation import tessellation_threads
+    from yade_electro.laws.conductance import make_law
+    from yade_electro.geometry.shapes import Box
+    from yade_electro.network.conduction import ConductionProblem
+    from yade_electro.network.kirchhoff import Electrode
+    from yade_electro.geometry.tessellation import tessellation_threads
     row = {"bench": "scale", "law": "voronoi"}
     st = {}
     cpu0 = time.process_time()

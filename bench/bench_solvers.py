@@ -43,10 +43,10 @@ SOLVERS = ("cg", "cg-deflated", "cg-amg", "direct")
 def rod_problem(n, seed=1):
     """(graph, conductances, electrodes) of the rod case's bonded packing (no YADE)."""
     import rod_resistance as rod
-    from yade_electro.conductance import conductance
-    from yade_electro.geometry import Cylinder
-    from yade_electro.graph import ContactGraph
-    from yade_electro.network import Electrode
+    from yade_electro.laws.conductance import conductance
+    from yade_electro.geometry.shapes import Cylinder
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.network.kirchhoff import Electrode
     from yade_electro.packing import bond_pairs, dense_packing
     pk = dense_packing(Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS), n=n, seed=seed)
     g = ContactGraph(pk.centers, pk.radii, bond_pairs(pk.centers, pk.radii))
@@ -56,7 +56,7 @@ def rod_problem(n, seed=1):
 
 
 def bench_size(n, repeat):
-    from yade_electro.network import ConductionProblem
+    from yade_electro.network.conduction import ConductionProblem
     g, c, el = rod_problem(n)
     rng = np.random.default_rng(0)
     best = {s: {} for s in SOLVERS}

@@ -4,7 +4,7 @@ runs one): the same solves with OpenBLAS at 1 and at 2 threads, blocks interleav
 For each size (the jittered lattice rods of bench_scale.py) and solver ('cg',
 'cg-deflated'): best of ``--repeat`` cold solves at each thread count, and
 ``ratio_2_over_1``. One JSON line per size and solver. The thread count is switched at run
-time with ``yade_electro.threads.limit_blas_threads`` (OpenBLAS' own call).
+time with ``yade_electro.core.threads.limit_blas_threads`` (OpenBLAS' own call).
 
     /usr/bin/python3 bench/bench_threads.py [--sizes 5000,20000,100000] [--repeat 5]
 """
@@ -32,9 +32,9 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from bench_scale import RADIUS, RHO, jittered_rod, reduced_rod_system
-    from yade_electro.conductance import conductance
-    from yade_electro.solvers import make_solver
-    from yade_electro.threads import blas_threads, limit_blas_threads
+    from yade_electro.laws.conductance import conductance
+    from yade_electro.solvers.registry import make_solver
+    from yade_electro.core.threads import blas_threads, limit_blas_threads
     start = blas_threads()
     for n in (int(s) for s in args.sizes.split(",")):
         g, top, bottom = jittered_rod(n)

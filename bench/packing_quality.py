@@ -64,8 +64,8 @@ def plots(pk, k, outdir):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     edges = P.bond_pairs(pk.centers, pk.radii, k)
-    from yade_electro.graph import ContactGraph
-    from yade_electro.surfaces import eccentricity
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.laws.transmission import eccentricity
     graph = ContactGraph(pk.centers, pk.radii, edges)
     e, deg = eccentricity(graph), graph.degree
     os.makedirs(outdir, exist_ok=True)

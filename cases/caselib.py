@@ -57,7 +57,7 @@ def sweep_runs(run_one, sizes, laws, out_dir, csv_name, fields, summary_line):
     ``out_dir`` as it comes (so a crash keeps the rows done) and its summary line printed, then a
     progress line on stderr (runs done, time spent, an estimate of the time left).
     Returns the rows."""
-    from yade_electro.progress import Progress
+    from yade_electro.core.progress import Progress
     os.makedirs(out_dir, exist_ok=True)
     rows = []
     runs = [(n, law) for n in sizes for law in laws]

@@ -31,9 +31,10 @@ HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].e
 if os.path.dirname(HERE) not in sys.path:
     sys.path.insert(0, os.path.dirname(HERE))
 
-from yade_electro.electrical import ElectricalModel  # noqa: E402
-from yade_electro.geometry import Cylinder, Shape, SurfaceSelector  # noqa: E402
-from yade_electro.graph import ContactGraph  # noqa: E402
+from yade_electro.physics.electrical import ElectricalModel  # noqa: E402
+from yade_electro.geometry.shapes import Cylinder, Shape  # noqa: E402
+from yade_electro.geometry.surfaces import SurfaceSelector  # noqa: E402
+from yade_electro.core.graph import ContactGraph  # noqa: E402
 from yade_electro.packing import bond_pairs, dense_packing  # noqa: E402
 
 INNER, OUTER, LENGTH = 0.4e-3, 1e-3, 1e-3       # m

@@ -113,7 +113,7 @@ def centre_nodes(pos, r=PARTICLE_RADIUS):
 
 
 def run(n=2000, dt=1.0, t_max=8000.0, seed=1, settle=1.0, out="out/container_heating", verbose=True):
-    from yade_electro.vtk import write_bonds, write_elements
+    from yade_electro.post.vtk import write_bonds, write_elements
     t0 = time.time()
     ids = fill_container(n, seed, settle, verbose)
     t_fill = time.time() - t0

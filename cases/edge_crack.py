@@ -74,7 +74,7 @@ def run_crack(n=10000, seed=1, rules=RULES, cache_dir=None):
     """Build the bonded bar in YADE, measure R_intact, break the bonds across the crack and
     measure R_crack for each crack rule; returns a dict of figures. Resets YADE's scene."""
     yade = import_yade()
-    from yade_electro.geometry import Box
+    from yade_electro.geometry.shapes import Box
     from yade_electro.yade import ElectricalEngine
     from yade_electro.yade import packing as P
 

@@ -91,7 +91,7 @@ def fall(ids, duration=0.35, snapshots=4, out="out/falling_bed", verbose=True):
     """Stage 1: the block falls with the heat engine; returns figures and snapshots."""
     from yade_electro.yade import HeatEngine
     from yade_electro.yade.runtime import import_yade
-    from yade_electro.vtk import write_elements
+    from yade_electro.post.vtk import write_elements
     O = import_yade().Omega()
     sph = ids["spheres"]
     hot = {int(i): T_HOT for i in sph if O.bodies[int(i)].state.pos[0] < 0}

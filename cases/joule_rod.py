@@ -19,7 +19,7 @@ Two DEM models
   capacities ``C_i = rho c V_i / fv_i`` (paper eq. 13);
 * ``voronoi``: conductances from the bounded Voronoi faces, capacities ``C_i = rho c
   V_cell_i`` from the bounded Voronoi cell volumes
-  (:func:`yade_electro.voronoi.voronoi_cell_volumes`; they fill the rod: their sum is
+  (:func:`yade_electro.geometry.voronoi.voronoi_cell_volumes`; they fill the rod: their sum is
   pi R^2 L to 3e-5).
 
 What is compared, and the error sources

@@ -60,7 +60,7 @@ def _solve(spec, law, solver, label):
 def run_mpi_rod(n=20000, seed=1, law="continuum", cache_dir=None):
     """Build the rod, solve it with 'petsc' (all ranks) and 'cg-deflated' (each rank); return
     the figures (the same on every rank)."""
-    from yade_electro.petsc_solver import import_petsc
+    from yade_electro.solvers.petsc import import_petsc
     comm = import_petsc().COMM_WORLD
     rod = build_rod(n, seed, cache_dir=cache_dir)
     ids, bottom, top = rod["ids"], rod["bottom"], rod["top"]
@@ -90,7 +90,7 @@ def main(argv=None):
     ap.add_argument("--law", default="continuum")
     args = ap.parse_args(argv)
     row = run_mpi_rod(args.n, args.seed, args.law)
-    from yade_electro.petsc_solver import import_petsc
+    from yade_electro.solvers.petsc import import_petsc
     if import_petsc().COMM_WORLD.getRank() == 0:
         print(f"{row['ranks']} rank(s), {row['n']} elements: R_eq {row['R_eq_petsc']:.6e} ohm (petsc), "
               f"{row['R_eq_serial']:.6e} ohm (cg-deflated); max |dphi| {row['max_potential_diff_V']:.2e} V; "

@@ -34,7 +34,7 @@ Electrodes and heating
   t = 0.01 s (the paper's rod heating; the ligament heats by ~300 K, so 304L stays solid);
 * DEM: ``ElectroThermalEngine``, backward Euler, ``nsteps`` = 100 thermal steps of 1e-4 s;
   capacities: 'continuum' uses the paper's rho c V_i / fv_i; 'voronoi' uses rho c V_cell
-  with the bounded Voronoi cell volumes (``yade_electro.voronoi.voronoi_cell_volumes``)
+  with the bounded Voronoi cell volumes (``yade_electro.geometry.voronoi.voronoi_cell_volumes``)
   when that function exists, else the fv capacities (the JSON says which: ``capacity``);
   a cell it returns with a non-positive volume keeps its element's fv capacity (counted in
   ``n_bad_cells``);
@@ -106,7 +106,7 @@ VOLTAGE, T_END = 1.0, 0.01
 SIZES = (5000, 10000, 20000, 40000)
 LAWS = ("continuum", "voronoi", "voronoi-surface")
 #: a "law" of the sweep: the conductance law, with "-surface" for electrodes on the end faces
-#: themselves (surface electrodes, see yade_electro.boundary) instead of element layers
+#: themselves (surface electrodes, see yade_electro.geometry.surface_contact) instead of element layers
 FEM_HS = (0.1e-3, 0.05e-3, 0.025e-3)
 #: Paper 000 figure 12 / text: (N, r_mean [um]); errors [%]: resistance 9.2 (5k) -> 6.7 (40k),
 #: notch temperature ~12 (5k), 5.8 (10k), "around 7" (20k, 40k)

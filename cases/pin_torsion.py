@@ -94,7 +94,7 @@ if os.path.dirname(HERE) not in sys.path:  # run from a checkout without install
 if HERE not in sys.path:
     sys.path.insert(0, HERE)
 
-from yade_electro.torsion import (crack_summary, elastic_slope, elastic_torque, polar_moment,  # noqa: E402
+from yade_electro.post.torsion import (crack_summary, elastic_slope, elastic_torque, polar_moment,  # noqa: E402
                                   ratio_at, yield_angle)
 
 RADIUS = 1e-3            # m
@@ -133,7 +133,7 @@ def build_pin(n, seed, young, strength, rate, ramp_time, check_every=STRENGTH_EV
     (packing, ids, rig, container, grip_bonds)."""
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()
-    from yade_electro.geometry import Cylinder
+    from yade_electro.geometry.shapes import Cylinder
     from yade_electro.yade import packing as P
     from yade_electro.yade.torsion_rig import TorsionRig, get_rig
     O = yade.Omega()
@@ -288,7 +288,7 @@ class _Snapshots:
                          broken=broken.copy(), theta=theta)
 
     def write(self, stage, snap=None):
-        from yade_electro.vtk import write_bonds, write_elements
+        from yade_electro.post.vtk import write_bonds, write_elements
         s = snap or self.last
         if s is None or stage in self.written:
             return

@@ -127,7 +127,7 @@ def hole_surface(tol=0.3 * SOURCE_DIAMETER / 2):
     """The source hole's surface as a surface selector: boundary faces within ``tol`` [m] of
     the hole's cylinder whose outward normal points into the hole (a concave wall is met by
     tangent planes, whose faces lie up to s^2 / (2 R) inside it, s their size)."""
-    from yade_electro.geometry import SurfaceSelector
+    from yade_electro.geometry.surfaces import SurfaceSelector
     c = np.array([WIDTH / 2, HEIGHT / 2])
     R = SOURCE_DIAMETER / 2
 
@@ -149,9 +149,9 @@ def electrode_layers(pos, r, r_mean, gap=0.1):
 
 def control_point_value(pos, potential, point, r_mean, fit_radius=2.5, min_points=6):
     """Linear least-squares fit of element potentials around the line through ``point``
-    along z, evaluated at ``point`` (see module doc; ``yade_electro.probes.probe``).
+    along z, evaluated at ``point`` (see module doc; ``yade_electro.post.probes.probe``).
     Returns (value, n_used)."""
-    from yade_electro.probes import probe
+    from yade_electro.post.probes import probe
     out = probe(pos, potential, point, fit_radius * r_mean, axis=(0, 0, 1), min_points=min_points)
     return float(out.value[0]), int(out.n_used[0])
 

@@ -207,7 +207,7 @@ def build_random(n=RANDOM_N, seed=1, width_d=6.0, height_d=10.0, progress=print)
     """Reset YADE: plate, four frictionless sides, a lid free along z, and ``n`` steel spheres
     placed densely in the box between them (the project's ``dense_packing``: no overlaps, touching
     the walls; radii +- 12.5 %). Returns dict(spheres, plate, lid, sides, width [m])."""
-    from yade_electro.geometry import Box
+    from yade_electro.geometry.shapes import Box
     from yade_electro.packing import dense_packing
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()

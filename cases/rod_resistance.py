@@ -136,7 +136,7 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     O.step()
     t_solve = time.perf_counter() - t1
     g = engine.bond_graph           # the bonds (the 'voronoi' law conducts on a wider network)
-    from yade_electro.surfaces import eccentricity
+    from yade_electro.laws.transmission import eccentricity
     e = eccentricity(g)
     R_dem = engine.equivalent_resistance
     R_th = theoretical_resistance(r_mean, rho) if electrodes == "layers" else rho * LENGTH / (math.pi * RADIUS ** 2)

@@ -183,7 +183,7 @@ def lacey_index(pos, is_a, cell=8 * PARTICLE_RADIUS, min_count=5) -> float:
 def run(n=2000, rpm=20.0, baffles=False, duration=3.0, sample=0.1, seed=1, out="out/rotating_drum", verbose=True,
         overlap=False):
     from yade_electro.yade.runtime import import_yade
-    from yade_electro.vtk import write_bonds, write_elements
+    from yade_electro.post.vtk import write_bonds, write_elements
     yade = import_yade()
     O = yade.Omega()
     t0 = time.time()

@@ -25,7 +25,7 @@ first layer touches the insulated wall x = 0 (nothing to impose: no bond crosses
 last layer is the fixed-temperature set and its centres sit on x = L, as electrodes sit on
 element centres in paper 000's rod (the analytic slab is the part between the wall and
 these centres). Conductances come from the 'voronoi' law and capacities from the bounded
-Voronoi cells (:func:`yade_electro.voronoi.voronoi_cell_volumes`): every cell is the cube
+Voronoi cells (:func:`yade_electro.geometry.voronoi.voronoi_cell_volumes`): every cell is the cube
 h^3 and every bond conducts lambda h, so the DEM is exactly the cell-centred finite-volume
 scheme of the 1D equation (second order in h) and the comparison measures the time
 integrators, not the packing. A random packed bar would add the packing's own
@@ -73,11 +73,13 @@ HERE = os.path.dirname(os.path.abspath(_SCRIPT))
 if os.path.dirname(HERE) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, os.path.dirname(HERE))
 
-from yade_electro.errors import ThermalError  # noqa: E402
+from yade_electro.core.errors import ThermalError  # noqa: E402
 from yade_electro.fem.closed_forms import slab_temperature  # noqa: E402
-from yade_electro.graph import ContactGraph  # noqa: E402
-from yade_electro.thermal import FixedTemperature, HeatSolver, diffusion_time_step  # noqa: E402
-from yade_electro.voronoi import voronoi_cell_volumes  # noqa: E402
+from yade_electro.core.graph import ContactGraph  # noqa: E402
+from yade_electro.network.conditions import FixedTemperature  # noqa: E402
+from yade_electro.network.transient import HeatSolver  # noqa: E402
+from yade_electro.physics.thermal import diffusion_time_step  # noqa: E402
+from yade_electro.geometry.voronoi import voronoi_cell_volumes  # noqa: E402
 
 LENGTH = 1.0            # m (paper 003)
 T_INITIAL = 0.0         # paper 003: 0 degC
@@ -100,8 +102,8 @@ class SlabModel:
 
     def __init__(self, layers=20, cross=2, length=LENGTH, conductivity=CONDUCTIVITY, density=DENSITY,
                  specific_heat=SPECIFIC_HEAT):
-        from yade_electro.yade.packing import Box      # numpy only (no YADE import)
-        from yade_electro.conductance import conductance
+        from yade_electro.geometry.shapes import Box  # numpy only (no YADE import)
+        from yade_electro.laws.conductance import conductance
         self.layers, self.cross, self.length = int(layers), int(cross), float(length)
         self.h = h = length / (layers + 0.5)
         nx, ny, nz = layers + 1, cross, cross
@@ -143,7 +145,7 @@ class SlabModel:
     def limits(self) -> dict:
         """Explicit step limits [s]: ``bound`` = min C_i / sum G (HeatSolver), ``true`` = 2 /
         lambda_max of C^-1 M on the free nodes, ``paper`` = l_min^2 / (2 alpha)."""
-        from yade_electro.network import laplacian
+        from yade_electro.network.kirchhoff import laplacian
         heat = self.solver(0.0)
         u = ~self.fixed
         K = laplacian(self.graph.edges, self.G, self.graph.n_nodes).tocsr()[u][:, u].toarray()
@@ -210,7 +212,7 @@ def forward_euler_growth(model: SlabModel, dt, n_steps=2000, noise=1e-10, seed=0
     the max deviation from the analytic solution every 10 steps (array)."""
     lim = model.limits()
     K, c = lim["_K"], lim["_c"]
-    from yade_electro.network import laplacian
+    from yade_electro.network.kirchhoff import laplacian
     u = ~model.fixed
     Kf = laplacian(model.graph.edges, model.G, model.graph.n_nodes).tocsr()
     kd = -(Kf[u][:, ~u] @ np.full(int((~u).sum()), T_WALL))     # heat from the fixed layer [W/K x K]

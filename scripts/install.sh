@@ -166,8 +166,8 @@ basis = Basis(MeshTet().refined(2), ElementTetP1())
 u = solve(*condense(laplace.assemble(basis), unit_load.assemble(basis),
                     D=basis.mesh.boundary_nodes()))
 assert 0.0 < u.max() < 0.1, "scikit-fem Poisson solve gave %r" % u.max()
-# petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.petsc_solver finds it)
-from yade_electro.petsc_solver import import_petsc
+# petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.solvers.petsc finds it)
+from yade_electro.solvers.petsc import import_petsc
 PETSc = import_petsc()
 # the CGAL Delaunay helper: built now, once, so that the first 'voronoi' run does not wait
 from yade_electro.native import cgal_executable

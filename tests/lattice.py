@@ -19,7 +19,7 @@ corner    3           2/sqrt3       2                    alpha(3)/2 = (9 sqrt3 -
 """
 import numpy as np
 
-from yade_electro.graph import ContactGraph
+from yade_electro.core.graph import ContactGraph
 
 __all__ = ["cubic_lattice", "lattice_index", "lattice_coords", "node_class", "lattice_edges"]
 

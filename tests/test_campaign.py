@@ -1,4 +1,4 @@
-"""yade_electro.campaign: a yade-batch campaign's job logs into one table. The parsing on logs in
+"""yade_electro.post.campaign: a yade-batch campaign's job logs into one table. The parsing on logs in
 yade-batch's format (OK, FAILED, unfinished, no JSON line), and a real two-job campaign run by
 ``yade-electro batch`` into a log directory that did not exist, gathered by ``yade-electro gather``."""
 import json
@@ -10,7 +10,7 @@ import pytest
 
 from conftest import repo_env
 
-from yade_electro.campaign import gather, main, markdown_table, read_job_log, results_table
+from yade_electro.post.campaign import gather, main, markdown_table, read_job_log, results_table
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

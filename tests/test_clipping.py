@@ -3,9 +3,9 @@ exact volumes and areas."""
 import numpy as np
 import pytest
 
-from yade_electro.clipping import FaceSet, clip, face_areas, order_polygons, volumes
-from yade_electro.geometry import Box, Cylinder
-from yade_electro.voronoi import bounded_cells
+from yade_electro.geometry.clipping import FaceSet, clip, face_areas, order_polygons, volumes
+from yade_electro.geometry.shapes import Box, Cylinder
+from yade_electro.geometry.voronoi import bounded_cells
 
 
 def cubes(offsets):

@@ -6,13 +6,13 @@ import math
 import numpy as np
 import pytest
 
-from yade_electro.contacts import (WallGeometry, candidate_pairs, plane_contact_radius, triangle_distance,
+from yade_electro.geometry.contacts import (WallGeometry, candidate_pairs, plane_contact_radius, triangle_distance,
                                    wall_candidates, wall_overlaps)
-from yade_electro.conductance import make_law
-from yade_electro.coupled import ElectroThermalModel
-from yade_electro.errors import BoundaryConditionError
-from yade_electro.graph import ContactGraph
-from yade_electro.thermal import ThermalWall
+from yade_electro.laws.conductance import make_law
+from yade_electro.physics.coupled import ElectroThermalModel
+from yade_electro.core.errors import BoundaryConditionError
+from yade_electro.core.graph import ContactGraph
+from yade_electro.network.conditions import ThermalWall
 
 
 def test_candidate_pairs_are_every_close_pair():
@@ -45,9 +45,9 @@ def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
     shifts: the same a^2 to 1e-14 r_max^2 (a last-bit difference in the centre distance, numpy's
     einsum sums the squares in another order, is amplified in a^2 = r1^2 - x^2 for small
     contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way."""
-    import yade_electro.contacts as C
-    from yade_electro.conductance import contact_radius, edge_lengths
-    from yade_electro.errors import MaterialError
+    import yade_electro.geometry.contacts as C
+    from yade_electro.laws.conductance import contact_radius, edge_lengths
+    from yade_electro.core.errors import MaterialError
     from yade_electro.native import NativeError, contact_radii
     try:
         contact_radii(np.zeros((1, 3)), np.ones(1), np.zeros((0, 2), dtype=np.int64))
@@ -91,7 +91,7 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     1e-15 relative; exactly on the degenerate cases), the Verlet list and a facet mesh's
     candidates identical; the deepest overlaps the same from sorted or shuffled candidates; a
     sparse box (a sphere far away) goes to the tree."""
-    import yade_electro.contacts as C
+    import yade_electro.geometry.contacts as C
     rng = np.random.default_rng(8)
     k = 4000
     tri = rng.uniform(-1, 1, (k, 3, 3))
@@ -139,7 +139,7 @@ def test_facet_vertices_compiled_numpy_and_scipy_rotation_agree(monkeypatch):
     """The facets' world vertices from their poses: the compiled pass, the numpy form and
     scipy's Rotation (a reference we did not write) on random unit quaternions."""
     from scipy.spatial.transform import Rotation
-    import yade_electro.contacts as C
+    import yade_electro.geometry.contacts as C
     rng = np.random.default_rng(11)
     k = 500
     q = rng.normal(size=(k, 4))
@@ -247,7 +247,7 @@ def test_wall_inputs_are_checked():
 
 
 def test_feng_pipe_law():
-    from yade_electro.conductance import PipeLaw
+    from yade_electro.laws.conductance import PipeLaw
     r, w, a = 1e-3, 5e-3, 0.2e-3
     d = 2 * math.sqrt(r ** 2 - a ** 2)                    # half chord a
     g = ContactGraph(np.array([[0, 0, 0], [d, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
@@ -281,7 +281,7 @@ def _periodic_brute_force(pos, radius, skin, H):
 @pytest.mark.parametrize("sheared", [False, True])
 def test_periodic_candidate_pairs_are_every_close_image(sheared):
     # centres anywhere (YADE does not wrap them): up to 3 cells away from the reference one
-    from yade_electro.contacts import periodic_candidate_pairs
+    from yade_electro.geometry.contacts import periodic_candidate_pairs
     rng = np.random.default_rng(7 + sheared)
     H = np.diag([0.02, 0.015, 0.018])
     if sheared:
@@ -299,8 +299,8 @@ def test_periodic_candidate_pairs_are_every_close_image(sheared):
 
 
 def test_periodic_cell_too_small_is_refused():
-    from yade_electro.contacts import periodic_candidate_pairs
-    from yade_electro.errors import GraphError
+    from yade_electro.geometry.contacts import periodic_candidate_pairs
+    from yade_electro.core.errors import GraphError
     pos = np.array([[0.001, 0.001, 0.001], [0.003, 0.001, 0.001]])
     with pytest.raises(GraphError, match="periodic cell is too small"):
         periodic_candidate_pairs(pos, np.full(2, 1e-3), 1e-4, np.eye(3) * 0.004)
@@ -310,7 +310,7 @@ def test_periodic_cell_too_small_is_refused():
 
 def test_periodic_graph_lengths_and_contact_factors():
     # two spheres touching through the cell's face: the shift gives their contact
-    from yade_electro.contacts import periodic_candidate_pairs
+    from yade_electro.geometry.contacts import periodic_candidate_pairs
     H = np.eye(3) * 0.02
     pos = np.array([[0.0005, 0.01, 0.01], [0.0195 + 0.04, 0.01, 0.01]])    # the second two periods away
     radius = np.array([1e-3, 1e-3])
@@ -355,7 +355,7 @@ def test_heat_carried_by_particles_closes_the_balance():
 def test_candidate_pairs_over_a_wide_size_spread():
     # radii spread over a factor 25 (size classes): the same pairs as the brute force, plain
     # and periodic
-    from yade_electro.contacts import SIZE_CLASS_RATIO, periodic_candidate_pairs
+    from yade_electro.geometry.contacts import SIZE_CLASS_RATIO, periodic_candidate_pairs
     rng = np.random.default_rng(11)
     n = 500
     rad = np.exp(rng.uniform(np.log(0.2e-3), np.log(5e-3), n))

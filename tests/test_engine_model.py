@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from yade_electro import BoundaryConditionError, MaterialError, equivalent_resistance
-from yade_electro.conductance import conductance
-from yade_electro.electrical import ElectricalModel, ElectrodeSpec, select_nodes
-from yade_electro.history import History
-from yade_electro.solvers import CGSolver
+from yade_electro.laws.conductance import conductance
+from yade_electro.physics.electrical import ElectricalModel, ElectrodeSpec
+from yade_electro.core.selection import select_nodes
+from yade_electro.core.history import History
+from yade_electro.solvers.cg import CGSolver
 
 from lattice import cubic_lattice, end_selectors
 
@@ -304,8 +305,8 @@ def test_model_summary_goes_into_a_history(tmp_path):
 
 
 def test_plot_history_from_csv_and_history(tmp_path):
-    from yade_electro.history import History
-    from yade_electro.plotting import plot_history
+    from yade_electro.core.history import History
+    from yade_electro.post.plotting import plot_history
     h = History(str(tmp_path / "h.csv"))
     for k in range(4):
         h.append({"iter": k, "time": 1e-3 * k, "R_eq": 1e-3, "current": 1e3, "joule_power": 1e3,

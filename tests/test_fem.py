@@ -10,7 +10,7 @@ import pytest
 
 skfem = pytest.importorskip("skfem")
 
-from yade_electro.errors import BoundaryConditionError, MaterialError, ThermalError  # noqa: E402
+from yade_electro.core.errors import BoundaryConditionError, MaterialError, ThermalError  # noqa: E402
 from yade_electro import fem  # noqa: E402
 from yade_electro.fem import (STEEL_304L, box_mesh, coax_mesh, converged,  # noqa: E402
                               joule_heating, notched_bar, plate_potential, richardson, rod_mesh,

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from yade_electro import BoundaryConditionError, ContactGraph, Electrode, MaterialError
-from yade_electro.conductance import conductance
-from yade_electro.electrical import ElectricalModel, ElectrodeSpec
-from yade_electro.history import History
-from yade_electro.materials import Material
-from yade_electro.network import ConductionProblem, solve_potential
-from yade_electro.selection import check_selector
+from yade_electro.laws.conductance import conductance
+from yade_electro.physics.electrical import ElectricalModel, ElectrodeSpec
+from yade_electro.core.history import History
+from yade_electro.core.materials import Material
+from yade_electro.network.conduction import ConductionProblem, solve_potential
+from yade_electro.core.selection import check_selector
 
 from lattice import cubic_lattice, end_selectors
 
@@ -113,7 +113,7 @@ def test_broken_edges_keep_the_structure_until_the_network_splits():
 
 
 def test_model_follows_moves_and_resistivity_without_rebuilding():
-    from yade_electro.geometry import Box
+    from yade_electro.geometry.shapes import Box
     g = rod()
     box = Box((-R, -R, -R), 2 * R * np.array(SHAPE) - R)
     m = ElectricalModel(RHO, {"top": dict(select=top, potential=1.0), "bottom": dict(select=bottom, potential=0.0)},

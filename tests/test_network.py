@@ -1,7 +1,7 @@
 """Kirchhoff solve: exact answers on small networks and lattices, conservation, symmetry,
 agreement of the solvers, re-use of the setup, and bad input.
 
-Sign conventions under test (yade_electro.network):
+Sign conventions under test (yade_electro.network.conduction):
 * ``branch_current[k]`` flows from ``edges[k, 0]`` to ``edges[k, 1]``: w = c (u_i - u_j);
 * ``electrode_current[name]`` is fed *into* the network by the external circuit;
 * R_eq(a, b) = (V_a - V_b) / I_a.
@@ -16,9 +16,11 @@ from scipy.spatial import cKDTree
 
 from yade_electro import (BoundaryConditionError, ContactGraph, Electrode, MaterialError, SolverError,
                           equivalent_resistance, laplacian, make_solver, solve_potential)
-from yade_electro.conductance import conductance
-from yade_electro.network import ConductionProblem
-from yade_electro.solvers import CGSolver, DirectSolver, solver_names
+from yade_electro.laws.conductance import conductance
+from yade_electro.network.conduction import ConductionProblem
+from yade_electro.solvers.cg import CGSolver
+from yade_electro.solvers.base import DirectSolver
+from yade_electro.solvers.registry import solver_names
 
 from lattice import cubic_lattice, lattice_index, node_class
 
@@ -511,8 +513,8 @@ def test_cg_that_cannot_converge_raises(random_network):
 def test_deflation_caps_its_clusters():
     """With more clusters than max_clusters the clusters grow until there are about that many;
     the solution stays the same to the tolerance; a bad cap is refused."""
-    from yade_electro.network import laplacian
-    from yade_electro.solvers import DeflatedCGSolver
+    from yade_electro.network.kirchhoff import laplacian
+    from yade_electro.solvers.deflation import DeflatedCGSolver
     g = cubic_lattice((12, 12, 48), 0.5e-3)
     A = (laplacian(g.edges, np.ones(len(g.edges)), g.n_nodes) + 1e-3 * sp.eye(g.n_nodes)).tocsr()   # SPD
     b = np.random.default_rng(0).random(g.n_nodes)
@@ -533,7 +535,7 @@ def test_deflation_caps_its_clusters():
 def test_reduced_system_is_the_condensed_laplacian(repeats, with_groups):
     """ReducedSystem's K_uu and K_ud against a dense Laplacian, for distinct and repeated
     edges (the scatter and the bincount paths), assembled twice in place."""
-    from yade_electro.condensation import ReducedSystem
+    from yade_electro.network.condensation import ReducedSystem
     rng = np.random.default_rng(7 + 2 * repeats + with_groups)
     n = 80
     e = np.sort(rng.integers(0, n, (300, 2)), axis=1)
@@ -567,7 +569,7 @@ def test_compiled_laplacian_fill_is_the_numpy_one(repeats, monkeypatch):
     laplacian_fill.cpp) give scipy's pattern and numpy's values to the last bit, with and
     without an extra diagonal, for distinct and repeated edges;
     K_ud and K_dd are the same; without the helper it falls back to numpy."""
-    from yade_electro.condensation import ReducedSystem
+    from yade_electro.network.condensation import ReducedSystem
     import yade_electro.native as native
     rng = np.random.default_rng(3 + repeats)
     n = 400
@@ -627,8 +629,8 @@ def test_compiled_deflated_cg_is_the_numpy_one(monkeypatch):
     coarse matrix) against its numpy form: the same iterations (+-1), the same solution to
     the tolerance, cold and after value updates (dense- and sparse-coarse sizes); a matrix
     that is not positive definite is refused as by numpy; without the helper, numpy."""
-    from yade_electro.network import laplacian
-    from yade_electro.solvers import DeflatedCGSolver
+    from yade_electro.network.kirchhoff import laplacian
+    from yade_electro.solvers.deflation import DeflatedCGSolver
     import yade_electro.native as native
     rng = np.random.default_rng(11)
     for shape in ((6, 6, 24), (14, 14, 40)):        # 54 and 720 clusters: dense and sparse coarse in numpy
@@ -683,7 +685,7 @@ def test_compiled_deflated_cg_is_the_numpy_one(monkeypatch):
 def test_compiled_deflated_cg_refuses_an_indefinite_matrix():
     """A symmetric matrix with a positive diagonal that is not positive definite: the compiled
     deflated CG says so (coarse factor or breakdown), as numpy's does, instead of a NaN."""
-    from yade_electro.solvers import DeflatedCGSolver
+    from yade_electro.solvers.deflation import DeflatedCGSolver
     n = 200
     rng = np.random.default_rng(3)
     coords = rng.random((n, 3))

@@ -239,8 +239,8 @@ def test_bonds_and_statistics(rod):
     assert st["e_below_0.4_core"] > st["e_below_0.4_surface"]
     assert st["max_overlap"] <= 1e-6
     # eccentricity agrees with the core's definition (surfaces.eccentricity on a ContactGraph)
-    from yade_electro.graph import ContactGraph
-    from yade_electro.surfaces import eccentricity
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.laws.transmission import eccentricity
     e = eccentricity(ContactGraph(rod.centers, rod.radii, edges))
     assert st["e_below_0.4"] == pytest.approx(np.mean(e < 0.4))
     # coordination grows with the detection factor; calibration hits the target
@@ -298,8 +298,8 @@ YADE_SCRIPT = textwrap.dedent("""
     out["tension_expected"] = i0.phys.kn * (i0.phys.unp - i0.geom.penetrationDepth)
     # JCFpm variant on a fresh scene, every progress line printed
     O.reset()
-    import yade_electro.progress
-    yade_electro.progress.PROGRESS_EVERY = 0.0
+    import yade_electro.core.progress
+    yade_electro.core.progress.PROGRESS_EVERY = 0.0
     ids = P.add_bonded_packing(pk, material=JCFpmMat(young=210e9, poisson=0.3, density=7900, cohesion=5e8, tensileStrength=5e8, frictionAngle=0.4), detection_factor=k)
     real = [i for i in O.interactions if i.isReal]
     out["jcfpm_bonds"] = len(real)
@@ -309,7 +309,7 @@ YADE_SCRIPT = textwrap.dedent("""
     # a large packing's collider sorts along the longest extent (the rod's axis, z): same bonds
     pairs_x = sorted((min(i.id1, i.id2), max(i.id1, i.id2)) for i in real)
     O.reset()
-    yade_electro.progress.PROGRESS_EVERY = 10.0
+    yade_electro.core.progress.PROGRESS_EVERY = 10.0
     import yade_electro.yade.bonding as B
     B.SORT_ALONG_LONGEST_FROM = 1
     ids = P.add_bonded_packing(pk, material=JCFpmMat(young=210e9, poisson=0.3, density=7900, cohesion=5e8, tensileStrength=5e8, frictionAngle=0.4), detection_factor=k)

@@ -13,8 +13,8 @@ import pytest
 from lattice import cubic_lattice
 
 from yade_electro import Electrode, SolverError
-from yade_electro.network import ConductionProblem
-from yade_electro.solvers import check_solver_name, make_solver, solver_names
+from yade_electro.network.conduction import ConductionProblem
+from yade_electro.solvers.registry import check_solver_name, make_solver, solver_names
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 #: OpenMPI refuses to start as root without these (CI runs as root)
@@ -95,7 +95,7 @@ def test_petsc_update_keeps_setup_and_warm_starts():
 
 
 def test_petsc_missing_is_a_clear_error(monkeypatch):
-    import yade_electro.petsc_solver as ps
+    import yade_electro.solvers.petsc as ps
     monkeypatch.setitem(sys.modules, "petsc4py", None)          # import petsc4py -> ImportError
     monkeypatch.setattr(ps, "DEBIAN_PETSC4PY", "/nonexistent/petsc*/lib")
     with pytest.raises(SolverError, match="apt-get install python3-petsc4py"):
@@ -110,8 +110,8 @@ STANDALONE = textwrap.dedent("""
     sys.path.insert(0, sys.argv[1])
     from lattice import cubic_lattice
     from yade_electro import Electrode
-    from yade_electro.network import ConductionProblem
-    from yade_electro.petsc_solver import import_petsc
+    from yade_electro.network.conduction import ConductionProblem
+    from yade_electro.solvers.petsc import import_petsc
     g = cubic_lattice((10, 10, 40), r=1e-4)
     rng = np.random.default_rng(5)                        # the same values on every rank
     c = rng.uniform(0.5, 2.0, len(g.edges))

@@ -66,7 +66,7 @@ import json, math, sys
 import numpy as np
 from yade_electro.yade.runtime import import_yade
 yade = import_yade()
-from yade_electro.geometry import Cylinder
+from yade_electro.geometry.shapes import Cylinder
 from yade_electro.yade import ElectricalEngine
 from yade_electro.yade import packing as P
 O = yade.Omega()

@@ -1,8 +1,8 @@
-"""Probes (yade_electro.probes): exact for linear fields, documented bias for curved ones."""
+"""Probes (yade_electro.post.probes): exact for linear fields, documented bias for curved ones."""
 import numpy as np
 import pytest
 
-from yade_electro.probes import (ProbeError, element_gradients, line_probe, plane_probe, probe, region_mean,
+from yade_electro.post.probes import (ProbeError, element_gradients, line_probe, plane_probe, probe, region_mean,
                                  section_mean, slab_means)
 
 

@@ -1,7 +1,7 @@
-"""Progress lines of long work (yade_electro.progress): pure Python, no YADE."""
+"""Progress lines of long work (yade_electro.core.progress): pure Python, no YADE."""
 import io
 
-from yade_electro import progress as P
+from yade_electro.core import progress as P
 
 
 def test_nothing_printed_for_short_work():
@@ -40,7 +40,7 @@ def test_jamming_shows_progress_within_trials(monkeypatch, capsys):
     """Every trial of the jamming (and the initial cloud's relaxation) reports while it runs;
     the packing is the same as without the lines."""
     import numpy as np
-    from yade_electro.geometry import Cylinder
+    from yade_electro.geometry.shapes import Cylinder
     from yade_electro.packing import dense_packing
     from yade_electro.packing import jamming
     rod = Cylinder((0, 0, 0), (0, 0, 5e-3), 1e-3)
@@ -70,7 +70,7 @@ def test_sweeps_print_runs_done_and_time_left(tmp_path, capsys):
 
 
 def test_tessellation_slabs_report_through_the_same_reporter(monkeypatch, capsys):
-    from yade_electro import voronoi
+    from yade_electro.geometry import voronoi as voronoi
     monkeypatch.setattr(P, "PROGRESS_EVERY", 0.0)
     report = voronoi._progress_lines(1234)
     report(1, 4, 0.1)

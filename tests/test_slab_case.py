@@ -25,9 +25,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "cases"))
 import slab_transient as slab  # noqa: E402
 
-from yade_electro.errors import ThermalError  # noqa: E402
-from yade_electro.voronoi import cell_volume_of, voronoi_cell_volumes  # noqa: E402
-from yade_electro.yade.packing import Box, Cylinder  # noqa: E402
+from yade_electro.core.errors import ThermalError  # noqa: E402
+from yade_electro.geometry.voronoi import cell_volume_of, voronoi_cell_volumes  # noqa: E402
+from yade_electro.geometry.shapes import Box, Cylinder  # noqa: E402
 
 
 # --------------------------------------------------------------------------- cell volumes

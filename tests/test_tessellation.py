@@ -1,4 +1,4 @@
-"""yade_electro.tessellation: the Voronoi diagram from qhull's Delaunay triangulation as arrays.
+"""yade_electro.geometry.tessellation: the Voronoi diagram from qhull's Delaunay triangulation as arrays.
 Checked against scipy.spatial.Voronoi (qhull's own Voronoi output) face by face, and the
 slabbed, threaded path against the whole-set one; cospherical input (a lattice) gives the
 cube faces and nothing else with area."""
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial import Voronoi
 
-from yade_electro.tessellation import circumcentres, tessellate, tessellation_threads
+from yade_electro.geometry.tessellation import circumcentres, tessellate, tessellation_threads
 
 
 def _reference_faces(pts, n_real):
@@ -110,7 +110,7 @@ def test_thread_setting(monkeypatch):
 
 
 def test_cgal_and_qhull_give_the_same_faces(monkeypatch, capsys):
-    from yade_electro import progress
+    from yade_electro.core import progress as progress
     from yade_electro.native import cgal_executable
     cgal_executable()                                # built here (make install brings g++ and CGAL)
     pts, n = _cloud(5000, 3)

@@ -18,16 +18,19 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph, MaterialError, ThermalError, solve_potential
-from yade_electro.conductance import conductance
-from yade_electro.coupled import ElectroThermalModel
-from yade_electro.electrical import ElectricalModel
-from yade_electro.history import History
-from yade_electro.errors import BoundaryConditionError
-from yade_electro.network import Electrode
-from yade_electro.surfaces import edge_transmission_surface, volume_fraction
-from yade_electro.thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, diffusion_time_step,
-                                  edge_joule_power, electrical_power, exposed_area, heat_capacity,
-                                  joule_sources, stable_time_step, thermal_conductance, theta_of)
+from yade_electro.laws.conductance import conductance
+from yade_electro.physics.coupled import ElectroThermalModel
+from yade_electro.physics.electrical import ElectricalModel
+from yade_electro.core.history import History
+from yade_electro.core.errors import BoundaryConditionError
+from yade_electro.network.kirchhoff import Electrode
+from yade_electro.laws.transmission import edge_transmission_surface, volume_fraction
+from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux
+from yade_electro.network.transient import HeatSolver
+from yade_electro.laws.transmission import exposed_area
+from yade_electro.network.theta import theta_of
+from yade_electro.physics.thermal import diffusion_time_step, edge_joule_power, electrical_power, heat_capacity, joule_sources, thermal_conductance
+from yade_electro.network.theta import stable_time_step
 
 from lattice import cubic_lattice, end_selectors, node_class
 

@@ -10,13 +10,15 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph
-from yade_electro.boundary import boundary_areas
-from yade_electro.coupled import ElectroThermalModel
-from yade_electro.errors import BoundaryConditionError, ThermalError
-from yade_electro.geometry import Box, Cylinder, Difference, Plane
+from yade_electro.geometry.surface_contact import boundary_areas
+from yade_electro.physics.coupled import ElectroThermalModel
+from yade_electro.core.errors import BoundaryConditionError, ThermalError
+from yade_electro.geometry.shapes import Box, Cylinder, Difference
+from yade_electro.geometry.surfaces import Plane
 from yade_electro.packing import bond_pairs, dense_packing
-from yade_electro.thermal import Convection, FixedTemperature, HeatFlux, HeatSource
-from yade_electro.voronoi import bounded_cells
+from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux
+from yade_electro.network.conditions import HeatSource
+from yade_electro.geometry.voronoi import bounded_cells
 
 R, L = 1e-3, 5e-3
 LAM, RHO, CP = 15.0, 7900.0, 500.0
@@ -130,7 +132,7 @@ def test_a_steady_state_with_nowhere_for_the_heat_to_go_is_refused(rod):
 
 # -- curved walls: the half cell's curvature correction ---------------------------------------------
 def test_wall_curvature_is_that_of_the_smooth_piece_at_the_point():
-    from yade_electro.geometry import Sphere
+    from yade_electro.geometry.shapes import Sphere
     a = 0.4e-3
     coax = Difference(ROD, Cylinder((0, 0, -L), (0, 0, 2 * L), a))
     k = coax.wall_curvature(np.array([[R, 0, L / 2], [0, a, L / 2], [0.7e-3, 0, 0.0], [0, a, L - 1e-6]]))
@@ -142,7 +144,7 @@ def test_wall_curvature_is_that_of_the_smooth_piece_at_the_point():
 
 
 def test_half_cell_length_is_exact_under_cylindrical_walls():
-    from yade_electro.boundary import CURVATURE_LIMITS, half_cell_length
+    from yade_electro.geometry.surface_contact import CURVATURE_LIMITS, half_cell_length
     a, d = 0.4e-3, 50e-6
     assert half_cell_length(d, -1 / a) == pytest.approx(a * math.log(1 + d / a), rel=1e-12)     # hole
     assert half_cell_length(d, 1 / R) == pytest.approx(R * math.log(R / (R - d)), rel=1e-12)     # rod side

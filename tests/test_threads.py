@@ -2,8 +2,8 @@
 YADE_ELECTRO_BLAS_THREADS (default 1) once the solvers are imported."""
 import pytest
 
-from yade_electro import solvers  # noqa: F401  (applies the default limit)
-from yade_electro import threads as T
+from yade_electro.solvers import registry as solvers  # noqa: F401  (applies the default limit)
+from yade_electro.core import threads as T
 
 
 def test_solvers_hold_openblas_to_one_thread(monkeypatch):

@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
-from yade_electro.torsion import (crack_summary, elastic_slope, elastic_torque, first_crossing, polar_moment,
+from yade_electro.post.torsion import (crack_summary, elastic_slope, elastic_torque, first_crossing, polar_moment,
                                   ratio_at, surface_shear_stress, yield_angle)
-from yade_electro.vtk import write_bonds, write_elements
+from yade_electro.post.vtk import write_bonds, write_elements
 
 
 def test_closed_forms_of_the_pin():

@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph
-from yade_electro.conductance import conductance, make_law
-from yade_electro.electrical import ElectricalModel
-from yade_electro.geometry import Box
-from yade_electro.network import equivalent_resistance
-from yade_electro.voronoi import VoronoiFaces, voronoi_faces
+from yade_electro.laws.conductance import conductance, make_law
+from yade_electro.physics.electrical import ElectricalModel
+from yade_electro.geometry.shapes import Box
+from yade_electro.network.conduction import equivalent_resistance
+from yade_electro.geometry.voronoi import VoronoiFaces, voronoi_faces
 
 
 def test_cubic_lattice_faces_are_the_cube_faces():
@@ -104,7 +104,7 @@ def test_area_lookup_of_non_neighbours_is_zero():
 def test_cells_at_a_re_entrant_corner_are_not_cut_away():
     """An L-shaped solid (a box minus a box): tangent planes of the concave corner must not
     cut solid away; every cell keeps a volume and the cells fill the solid."""
-    from yade_electro.voronoi import voronoi_cell_volumes
+    from yade_electro.geometry.voronoi import voronoi_cell_volumes
     solid = Box((0, 0, 0), (2, 2, 1)) - Box((1, 1, -1), (3, 3, 2))
     rng = np.random.default_rng(5)
     pts = rng.uniform([0, 0, 0], [2, 2, 1], size=(3000, 3))
@@ -119,7 +119,7 @@ def test_cells_at_a_re_entrant_corner_are_not_cut_away():
 def test_coupled_model_takes_voronoi_cell_capacities_by_default():
     """With the voronoi law the heat capacities are rho c V_cell, from the law's own
     tessellation: they add up to rho c times the solid's volume."""
-    from yade_electro.coupled import ElectroThermalModel
+    from yade_electro.physics.coupled import ElectroThermalModel
     graph, box, L = _rod_graph(3, n=800)
     z = graph.pos[:, 2]
     el = ElectricalModel(1.0, {"top": dict(select=z > L - 0.2, potential=1.0),
@@ -174,7 +174,7 @@ def test_compiled_hop_test_agrees_with_the_sparse_matrix_powers(hops, monkeypatc
     """VoronoiFaces.linked by the compiled breadth-first helper against its fallback (powers of
     the adjacency matrix), on random graphs with isolated nodes and long chains."""
     from yade_electro import native
-    from yade_electro.voronoi import VoronoiFaces
+    from yade_electro.geometry.voronoi import VoronoiFaces
     rng = np.random.default_rng(hops)
     n = 3000
     b = np.sort(rng.integers(0, n, (4000, 2)), axis=1)

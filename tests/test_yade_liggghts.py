@@ -39,7 +39,7 @@ LIGGGHTS_TO_YADE = r'''
 import json, sys
 import numpy as np
 from yade_electro import liggghts as L
-from yade_electro.geometry import Cylinder
+from yade_electro.geometry.shapes import Cylinder
 from yade_electro.yade.spheres import add_spheres, bonded_packing
 from yade_electro.yade.bonding import add_bonded_packing
 R = 0.006

@@ -11,7 +11,7 @@ import numpy as np
 from yade import pack, utils
 from yade_electro.yade import ElectroThermalEngine, ElectricalEngine, attach
 from yade_electro.yade import packing as P
-from yade_electro.thermal import FixedTemperature, Convection
+from yade_electro.network.transient import FixedTemperature, Convection
 L, RAD = 2e-3, 0.5e-3
 shape = pack.inCylinder((0, 0, 0), (0, 0, L), RAD)
 def stretch():
@@ -185,7 +185,7 @@ import json
 import numpy as np
 from yade import pack
 from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
-from yade_electro.thermal import FixedTemperature, Convection, HeatFlux
+from yade_electro.network.transient import FixedTemperature, Convection, HeatFlux
 from yade_electro.yade import packing as P
 pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
 ids = np.asarray(P.add_bonded_packing(pk))

@@ -11,7 +11,7 @@ import json, math
 import numpy as np
 from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, HeatEngine, attach
 from yade_electro.yade import packing as P
-from yade_electro.thermal import FixedTemperature, Convection, HeatSource
+from yade_electro.network.transient import FixedTemperature, Convection, HeatSource
 L, RAD = 2e-3, 0.5e-3
 rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
 RHO, LAM = 7.3e-7, 16.2
@@ -67,9 +67,9 @@ print(json.dumps(dict(R=el.equivalent_resistance, T0=float(heat.temperature[0]),
 
 BAD = COMMON + r'''
 build()
-from yade_electro.errors import BoundaryConditionError
+from yade_electro.core.errors import BoundaryConditionError
 out = {}
-from yade_electro.geometry import Plane
+from yade_electro.geometry.shapes import Plane
 inside = Plane((0, 0, L / 2), (0, 0, 1), tol=1e-9)
 for name, make in (
         ("electrode", lambda: ElectricalEngine(RHO, {"a": dict(surface=inside, potential=1.0),

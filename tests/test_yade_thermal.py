@@ -11,7 +11,7 @@ import json, math
 import numpy as np
 from yade import pack, utils
 from yade_electro.yade import ElectroThermalEngine
-from yade_electro.thermal import Convection
+from yade_electro.network.transient import Convection
 O.materials.append(CohFrictMat(young=210e9, poisson=0.3, density=7900, normalCohesion=1e8, shearCohesion=1e8,
                                momentRotationLaw=True, label="steel"))
 r = 1e-4
@@ -103,7 +103,7 @@ def test_non_finite_temperatures_stop_and_keep_the_history(run_yade_script, tmp_
 
 
 BCS = SCENE + r'''
-from yade_electro.thermal import FixedTemperature, Convection
+from yade_electro.network.transient import FixedTemperature, Convection
 e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.05), "bottom": dict(select=BOTTOM, potential=0.0)},
                          density=7900, specific_heat=500, conductivity=15, temperature=293.15,
                          fixed=[FixedTemperature("cold end", BOTTOM, 293.15)],

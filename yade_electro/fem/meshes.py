@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import MeshTet
 
-from ..errors import ElectroError
+from ..core.errors import ElectroError
 
 __all__ = ["box_mesh", "rod_mesh", "coax_mesh", "plate_mesh", "notched_bar_mesh",
            "PlateGeometry", "NotchedBarGeometry", "MeshError", "mesh_size"]

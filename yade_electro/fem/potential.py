@@ -18,7 +18,7 @@ from scipy.sparse.linalg import splu
 from skfem import Basis, BilinearForm, ElementTetP1, ElementTetP2, LinearForm, asm
 from skfem.helpers import dot, grad
 
-from ..errors import BoundaryConditionError, MaterialError, SolverError
+from ..core.errors import BoundaryConditionError, MaterialError, SolverError
 from .probing import line_points, probe_matrix
 
 __all__ = ["solve_potential", "PotentialSolution", "make_basis", "field_at_quadrature",

@@ -11,7 +11,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.spatial import cKDTree
 
-from ..errors import ElectroError
+from ..core.errors import ElectroError
 
 __all__ = ["probe_matrix", "find_cells", "ProbeError", "line_points", "slab_average",
            "subdomain_average"]

@@ -28,7 +28,7 @@ import numpy as np
 from scipy.sparse import diags
 from skfem import FacetBasis, asm
 
-from ..errors import BoundaryConditionError, MaterialError, ThermalError
+from ..core.errors import BoundaryConditionError, MaterialError, ThermalError
 from .potential import (DirichletSolver, PotentialSolution, _diffusion, _mass, _source,
                         _as_points, dirichlet_dofs, field_at_quadrature, make_basis,
                         solve_potential)

@@ -21,7 +21,7 @@ written executable.
 without g++) took about 10 s and 1 GB.
 
 ``laplacian_fill``: the values of a condensed Laplacian's unknown block from new edge values
-(:func:`laplacian_fill`, used by :class:`yade_electro.condensation.ReducedSystem`), numpy's
+(:func:`laplacian_fill`, used by :class:`yade_electro.network.condensation.ReducedSystem`), numpy's
 operations in one pass, the same values to the last bit; measured on the rod problems in
 one process, 0.17 against 0.36-0.38 ms at 5,000 elements and 0.47-0.62 against 1.39-1.44 ms
 at 20,000 (2026-12-03).
@@ -32,16 +32,16 @@ numpy form's closest-point regions in one compiled pass; and the facets' world v
 their poses (:func:`facet_vertices`).
 
 ``contact_radii``: the contact radius of each sphere pair of the granular mode's Verlet list
-(:func:`contact_radii`, used by :func:`yade_electro.conductance.contact_radius`) and the
+(:func:`contact_radii`, used by :func:`yade_electro.laws.conductance.contact_radius`) and the
 centre distances of node pairs (:func:`pair_lengths`, used by
-:func:`yade_electro.conductance.edge_lengths`), numpy's operations in one pass.
+:func:`yade_electro.laws.conductance.edge_lengths`), numpy's operations in one pass.
 
 ``continuum_factors``: the geometric factors of the ``continuum`` law on every bond
-(:func:`continuum_factors`, used by :class:`yade_electro.conductance.ContinuumLaw`): the
+(:func:`continuum_factors`, used by :class:`yade_electro.laws.conductance.ContinuumLaw`): the
 neighbours' barycentres, the eccentricity factors and sqrt(S_i S_j) / l_ij in three passes.
 
 ``csr_pattern``: a CSR sparsity pattern from (row, col) pairs with each pair's slot in the
-data (:func:`csr_pattern`, used by :class:`yade_electro.condensation.ReducedSystem` for the
+data (:func:`csr_pattern`, used by :class:`yade_electro.network.condensation.ReducedSystem` for the
 Laplacian's pattern and the incidence matrix): scipy's COO -> CSR conversion and index sort
 in one call, the same pattern.
 
@@ -158,7 +158,7 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
         with open(fin, "wb") as fh:
             np.array([P.shape[0]], np.int64).tofile(fh)
             P.tofile(fh)
-        from ..progress import Progress
+        from ..core.progress import Progress
         progress = Progress("voronoi", f"{P.shape[0]:,} points triangulated by CGAL")
         proc = subprocess.Popen([str(exe), fin, fout, str(int(n_real))], stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True)
@@ -221,7 +221,7 @@ def hops_linked(indptr, indices, pairs, hops: int) -> np.ndarray:
     ``graph_hops`` helper: breadth-first balls of radius ceil(hops/2) around the first nodes
     and hops - that around the second; pairs sorted by their first node share the first
     ball. Raises :class:`NativeError` when it cannot be built (see
-    :meth:`yade_electro.voronoi.VoronoiFaces.linked` for the sparse-matrix fallback)."""
+    :meth:`yade_electro.geometry.voronoi.VoronoiFaces.linked` for the sparse-matrix fallback)."""
     f = _hops_library()
     ip = np.ascontiguousarray(indptr, dtype=np.int64)
     ix = np.ascontiguousarray(indices, dtype=np.int64)
@@ -358,7 +358,7 @@ class FireSteps:
 
 def laplacian_fill(data, c, e_uu, o1, o2, diag, incidence, extra=None) -> None:
     """``data`` (K_uu's CSR values) from the edge values ``c``, as
-    :meth:`yade_electro.condensation.ReducedSystem.assemble` fills them with numpy: -c at each
+    :meth:`yade_electro.network.condensation.ReducedSystem.assemble` fills them with numpy: -c at each
     unknown-unknown pair's off-diagonal entries ``o1``, ``o2`` (pair t is edge ``e_uu[t]``, or t
     when ``e_uu`` is None), the incidence matrix (CSR, unknowns x edges, ones) times c on the
     diagonal entries ``diag`` (int64), plus ``extra``. ``laplacian_fill.cpp``, one pass; raises
@@ -392,7 +392,7 @@ def _wall_function(symbol, argtypes, restype):
 
 def triangle_distance(points, triangles) -> np.ndarray:
     """Distance [m] from each point (k, 3) to the triangle (k, 3, 3) of its row, as
-    :func:`yade_electro.contacts.triangle_distance` computes it with numpy (the same regions
+    :func:`yade_electro.geometry.contacts.triangle_distance` computes it with numpy (the same regions
     and precedence); ``wall_contacts.cpp``. Raises :class:`NativeError` when it cannot be
     built."""
     import ctypes
@@ -411,7 +411,7 @@ def triangle_candidates(pos, radius, skin: float, triangles, centre, reach):
     """The (sphere, triangle) pairs closer than ``radius[i] + skin`` [m] among the spheres
     within ``reach[t]`` of the triangles' ball centres ``centre`` (k, 3): (spheres, pieces)
     int64 arrays sorted by sphere, then triangle, as
-    :func:`yade_electro.contacts.wall_candidates` finds them with a KD-tree;
+    :func:`yade_electro.geometry.contacts.wall_candidates` finds them with a KD-tree;
     ``wall_contacts.cpp``, a pass over every sphere and triangle. Raises :class:`NativeError`
     when it cannot be built."""
     import ctypes
@@ -435,7 +435,7 @@ def triangle_candidates(pos, radius, skin: float, triangles, centre, reach):
 def facet_vertices(pos, quat, local) -> np.ndarray:
     """World vertices (k, 3, 3) [m] of k rigid triangles from their positions (k, 3), unit
     quaternions (k, 4) stored (x, y, z, w) and vertices in the body frame (k, 3, 3), as
-    :func:`yade_electro.contacts.facet_vertices` computes them with numpy;
+    :func:`yade_electro.geometry.contacts.facet_vertices` computes them with numpy;
     ``wall_contacts.cpp``. Raises :class:`NativeError` when it cannot be built."""
     import ctypes
     i64, ptr = ctypes.c_int64, ctypes.c_void_p
@@ -453,7 +453,7 @@ def facet_vertices(pos, quat, local) -> np.ndarray:
 
 def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
     """Contact radius a [m] of each sphere pair ``edges`` (m, 2) (0 where the spheres do not
-    overlap), as :func:`yade_electro.conductance.contact_radius` computes it with numpy
+    overlap), as :func:`yade_electro.laws.conductance.contact_radius` computes it with numpy
     (``model`` 'geometric' or 'hertz'; ``shift`` (m, 3): the periodic image of the second
     sphere), and the number of pairs with coincident centres (their radii are not
     meaningful); ``contact_radii.cpp``, one pass. Raises :class:`NativeError` when it cannot
@@ -497,8 +497,8 @@ def pair_lengths(pos, edges, shift=None):
 def continuum_factors(pos, radius, alpha_r2, edges, threshold: float, factor: float):
     """g = sqrt(S_i S_j) / l_ij [m] of every bond ``edges`` (m, 2) of the ``continuum`` law,
     S_i = ``alpha_r2``[i] / f_i with the eccentricity factor f_i of the bonds' neighbour
-    barycentres (as :func:`yade_electro.surfaces.edge_transmission_surface` over
-    :func:`yade_electro.conductance.edge_lengths` computes them with numpy), and the number
+    barycentres (as :func:`yade_electro.laws.transmission.edge_transmission_surface` over
+    :func:`yade_electro.laws.conductance.edge_lengths` computes them with numpy), and the number
     of bonds with coincident centres (their g is not meaningful); ``continuum_factors.cpp``.
     Raises :class:`NativeError` when it cannot be built."""
     import ctypes
@@ -546,7 +546,7 @@ EIGEN_INCLUDE = "/usr/include/eigen3"
 
 
 class DeflatedCG:
-    """The iterations of :class:`yade_electro.solvers.DeflatedCGSolver` compiled
+    """The iterations of :class:`yade_electro.solvers.registry.DeflatedCGSolver` compiled
     (``deflated_cg.cpp``: the same deflated CG, coarse matrix factorised by Eigen's
     SimplicialLLT), for ``n`` unknowns and ``k`` clusters. Raises :class:`NativeError` when it
     cannot be built (needs g++ and Eigen's headers, ``libeigen3-dev``)."""

@@ -16,7 +16,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..geometry import GridShape
+from ..geometry.shapes import GridShape
 
 __all__ = ["default_cache_dir", "grid_hash", "cache_key", "cache_path", "load_cached", "store"]
 

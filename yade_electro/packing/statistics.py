@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..graph import ContactGraph
-from ..surfaces import eccentricity
+from ..core.graph import ContactGraph
+from ..laws.transmission import eccentricity
 from .jamming import max_overlap
 
 __all__ = ["DEFAULT_DETECTION_FACTOR", "bond_pairs", "detection_factor_for_coordination", "packing_statistics"]

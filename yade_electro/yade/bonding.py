@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from ..packing.statistics import DEFAULT_DETECTION_FACTOR
-from ..progress import Progress
+from ..core.progress import Progress
 
 __all__ = ["steel_304L", "add_bonded_packing"]
 

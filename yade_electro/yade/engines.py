@@ -40,14 +40,16 @@ from typing import Dict, NamedTuple, Optional
 
 import numpy as np
 
-from ..coupled import ElectroThermalModel
-from ..electrical import ElectricalModel, ElectrodeSpec
-from ..errors import BoundaryConditionError, MaterialError, ThermalError
-from ..geometry import Shape, as_shape
-from ..history import History
-from ..materials import real_number
-from ..thermal import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
-from . import persistence, registry
+from ..physics.coupled import ElectroThermalModel
+from ..physics.electrical import ElectricalModel, ElectrodeSpec
+from ..core.errors import BoundaryConditionError, MaterialError, ThermalError
+from ..geometry.shapes import Shape, as_shape
+from ..core.history import History
+from ..core.materials import real_number
+from ..network.conditions import Convection, FixedTemperature, HeatFlux
+from ..network.conditions import HeatSource, ThermalWall
+from . import persistence
+from . import registry
 from .runtime import import_yade
 from .granular import Capture, GranularReader, check_wall_bodies
 from .scene import SceneReader, TemperatureWriter, check_write_back, predicate_selector, write_body_attribute
@@ -244,7 +246,6 @@ class _Engine:
     def _save_config(self):
         kwargs = self._config_kwargs()
         saved, missing = {}, []
-        import pickle
         for k, v in kwargs.items():
             try:
                 pickle.dumps(v, protocol=4)
@@ -376,7 +377,7 @@ class ElectricalEngine(_Engine):
     container : Shape or YADE predicate, optional
         The solid. Default: ``law_params['container']``, else the container of the packing
         ``add_bonded_packing`` put in the scene.
-    law_params, solver, measure, reselect : see ``yade_electro.electrical.ElectricalModel``
+    law_params, solver, measure, reselect : see ``yade_electro.physics.electrical.ElectricalModel``
         (a YADE predicate as ``law_params['container']`` is converted to a shape)
     iterPeriod : int >= 1
         Steps between two calls (the PyRunner's period).
@@ -435,7 +436,7 @@ class ElectricalEngine(_Engine):
         granular = self._options_bonds == "contacts"
         if law is None:
             law = "contact" if granular else ("voronoi" if container is not None else "continuum")
-        from ..conductance import is_contact_law as _is_contact_law
+        from ..laws.conductance import is_contact_law as _is_contact_law
         is_contact_law = _is_contact_law(law)
         if granular and not is_contact_law:
             raise ValueError(f"law {law!r} is a law of bonded solids, but bonds='contacts' (a granular bed): use "
@@ -631,10 +632,10 @@ class ElectroThermalEngine(ElectricalEngine):
         temperatures are then the bodies' ``b.state.temp``).
     beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
     theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
-    fixed, flux, convection : lists of ``yade_electro.thermal`` FixedTemperature, HeatFlux,
+    fixed, flux, convection : lists of ``yade_electro.network.transient`` FixedTemperature, HeatFlux,
         Convection; their ``nodes`` may be YADE predicates, body id lists or masks, or give
         ``surface=`` (a surface of the container, as for electrodes)
-    sources : list of ``yade_electro.thermal.HeatSource`` (heat generated inside the solid,
+    sources : list of ``yade_electro.network.transient.HeatSource`` (heat generated inside the solid,
         W or W/m^3, shared by element volume)
     thermal_dt : float, optional; time_scale : float
     steady : bool
@@ -646,7 +647,7 @@ class ElectroThermalEngine(ElectricalEngine):
     coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
     walls : dict name -> dict(bodies=ids, temperature=K or None, conductivity=W/(m K)), optional
         Walls of a granular bed (``bonds='contacts'``): ``Wall``, ``Box`` or facet-mesh bodies,
-        isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.thermal.ThermalWall``.
+        isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.network.transient.ThermalWall``.
         Their heat is in the history (``wall_heat:<name>``) and in :meth:`wall_heat`.
     skin : Verlet skin of the granular mode (see ElectricalEngine)
     materials : dict YADE material -> dict(density=, specific_heat=, conductivity=, resistivity=), optional
@@ -744,13 +745,13 @@ class ElectroThermalEngine(ElectricalEngine):
             out = []
             for bc in group:
                 if not isinstance(bc, cls):
-                    raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.thermal), got {bc!r}")
+                    raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.network.transient), got {bc!r}")
                 out.append(bc if bc.nodes is None else dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
             bcs.append(out)
         heat_sources = []
         for src in sources:
             if not isinstance(src, HeatSource):
-                raise TypeError(f"expected HeatSource objects (yade_electro.thermal) in sources=, got {src!r}")
+                raise TypeError(f"expected HeatSource objects (yade_electro.network.transient) in sources=, got {src!r}")
             heat_sources.append(src if src.nodes is None else dataclasses.replace(
                 src, nodes=self._normalise_selector(src.nodes)))
         if not isinstance(steady, bool):
@@ -901,7 +902,7 @@ class ElectroThermalEngine(ElectricalEngine):
         data ``conductance_W_per_K``, ``heat_flow_W`` from the first body to the second, body
         ids ``id1``, ``id2``). In a periodic cell, a contact that crosses a face is drawn to
         the neighbour's image. Returns {'particles': path, 'contacts': path}."""
-        from ..vtk import write_bonds, write_elements
+        from ..post.vtk import write_bonds, write_elements
         if self.coupled.heat is None:
             raise RuntimeError(f"engine {self.label!r} has not run yet: call O.run (or engine.step()) first")
         graph = self.coupled.network.graph

@@ -5,7 +5,7 @@ Reading YADE's interactions from Python costs microseconds per contact: too much
 whose contacts change at every step. :class:`GranularReader` reads instead the positions
 with YADE's C++ bulk reader (``utils.coordsAndDisplacements``, about 1 ms for 5,000
 bodies) at every call, and finds the contacts itself: the edges are a Verlet list of the
-pairs closer than ``r_i + r_j + skin`` (:func:`yade_electro.contacts.candidate_pairs`), kept
+pairs closer than ``r_i + r_j + skin`` (:func:`yade_electro.geometry.contacts.candidate_pairs`), kept
 until some sphere (or wall) has moved by more than half the skin, and a pair conducts only
 while its spheres overlap (the contact laws give g = 0 otherwise). These are the contacts
 YADE's ``Ig2_Sphere_Sphere_ScGeom`` makes real (overlap > 0, detection factor 1); a larger
@@ -15,11 +15,11 @@ here either. Between two lists the engine sees a change of values on a kept stru
 Walls: ``walls={name: dict(bodies=ids, ...)}`` names YADE bodies whose shape is ``Wall``,
 ``Box`` or ``Facet`` (a facet mesh such as ``geom.facetCylinder`` given as one wall). Their
 geometry is read at every call (a few Python reads per body) and the spheres touching them
-are found with the same skin (:mod:`yade_electro.contacts`).
+are found with the same skin (:mod:`yade_electro.geometry.contacts`).
 
 Periodic cells (``O.periodic``, sheared or not, and deforming through ``O.cell.velGrad``):
 the Verlet list is made with the cell's images
-(:func:`yade_electro.contacts.periodic_candidate_pairs`); the graph's positions are the
+(:func:`yade_electro.geometry.contacts.periodic_candidate_pairs`); the graph's positions are the
 centres wrapped into the cell (what the selections, the outputs and VTK see) and each edge
 carries the shift of its image (``ContactGraph.shift``), recomputed at every call from the
 cell and the spheres' own periods, so a sphere leaving the cell through a face keeps its
@@ -41,10 +41,10 @@ from typing import Dict, List, NamedTuple, Optional
 
 import numpy as np
 
-from ..contacts import (WallGeometry, candidate_pairs, facet_vertices, max_displacement, periodic_candidate_pairs,
+from ..geometry.contacts import (WallGeometry, candidate_pairs, facet_vertices, max_displacement, periodic_candidate_pairs,
                         quaternion_matrices, wall_candidates, wall_overlaps)
-from ..errors import BoundaryConditionError, GraphError
-from ..graph import ContactGraph
+from ..core.errors import BoundaryConditionError, GraphError
+from ..core.graph import ContactGraph
 from .runtime import import_yade
 from .scene import bulk_coordinates, probe_replaced, read_spheres, warn_left_out
 

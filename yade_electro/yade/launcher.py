@@ -17,7 +17,7 @@ script's namespace, ``-x``, ``readParamsFromTable``) is YADE's::
 
 ``batch`` runs ``yade-batch`` with its jobs started by this launcher (``--executable``) and
 without its own HTTP summary server (port 9080 on all interfaces): the jobs' logs are the
-record. ``gather`` reads those logs (:mod:`yade_electro.campaign`; no YADE needed).
+record. ``gather`` reads those logs (:mod:`yade_electro.post.campaign`; no YADE needed).
 ``python3 -m yade_electro.yade.launcher`` is the same command.
 
 Environment: ``YADE_ELECTRO_YADE`` / ``YADE_ELECTRO_YADE_BATCH`` name other YADE launchers.
@@ -130,7 +130,7 @@ def made_log_directories(args) -> list:
 def main(argv=None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["gather"]:
-        from ..campaign import main as gather_main
+        from ..post.campaign import main as gather_main
         sys.exit(gather_main(argv[1:]))
     if argv[:1] == ["batch"]:
         args = argv[1:]

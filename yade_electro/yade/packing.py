@@ -1,12 +1,12 @@
 """The packing recipe in one namespace, for YADE scripts: container shapes
-(:mod:`yade_electro.geometry`), dense placement and statistics (:mod:`yade_electro.packing`)
+(:mod:`yade_electro.geometry.shapes`), dense placement and statistics (:mod:`yade_electro.packing`)
 and YADE bonding (:mod:`yade_electro.yade.bonding`).
 
 ``from yade_electro.yade import packing as P`` then ``P.add_bonded_packing(P.dense_packing(
 pack.inCylinder(...), n=5000))`` is the two-line recipe of paper 000 section 2.1. This module
 holds no code of its own; it names what the three modules hold.
 """
-from ..geometry import (Box, Cylinder, Difference, GridShape, Intersection, Shape, Sphere, Union, as_shape,
+from ..geometry.shapes import (Box, Cylinder, Difference, GridShape, Intersection, Shape, Sphere, Union, as_shape,
                         container_volume)
 from ..packing import (DEFAULT_DETECTION_FACTOR, PACKING_VERSION, SpherePacking, bond_pairs, dense_packing,
                        detection_factor_for_coordination, mean_radius_for_count, packing_statistics)

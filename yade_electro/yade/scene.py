@@ -60,8 +60,8 @@ from typing import Dict, List, NamedTuple, Optional
 
 import numpy as np
 
-from ..errors import GraphError
-from ..graph import ContactGraph
+from ..core.errors import GraphError
+from ..core.graph import ContactGraph
 from .runtime import import_yade
 
 __all__ = ["SceneReader", "write_body_attribute", "TemperatureWriter", "ensure_thermal_state", "predicate_selector",

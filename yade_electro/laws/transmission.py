@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .graph import ContactGraph
+from ..core.graph import ContactGraph
 
 __all__ = [
     "POLYHEDRON_FACES", "POLYHEDRON_ALPHA", "POLYHEDRON_FV",
     "polyhedron_alpha", "polyhedron_volume_fraction", "eccentricity", "eccentricity_factor",
-    "transmission_surface", "edge_transmission_surface", "volume_fraction",
+    "transmission_surface", "edge_transmission_surface", "volume_fraction", "exposed_area",
 ]
 
 #: Face counts of the regular polyhedra (tetrahedron, cube, octahedron, dodecahedron, icosahedron).
@@ -123,3 +123,17 @@ def volume_fraction(graph: ContactGraph, threshold: float = 0.4, factor: float =
     """
     f = eccentricity_factor(eccentricity(graph), threshold, factor)
     return polyhedron_volume_fraction(graph.degree) * f
+
+
+def exposed_area(graph: ContactGraph, threshold: float = 0.4) -> np.ndarray:
+    """Default exposed (free-surface) area A_i of every element [m^2] for convection and
+    surface fluxes: ``pi r_i^2`` where the eccentricity e_i > ``threshold`` (the elements the
+    continuum model treats as on the surface, f_i = 2), 0 elsewhere.
+
+    This is a crude estimate (one great-circle disc per surface element; the face elements
+    of a simple cubic lattice, e = 0.4 exactly, count as interior). When the surface
+    exchange matters, pass the areas yourself (``area=`` of :class:`Convection` /
+    :class:`HeatFlux`), e.g. the boundary faces of the Voronoi cells.
+    """
+    e = eccentricity(graph)
+    return np.where(e > threshold * (1.0 + 1e-9), np.pi * graph.radius ** 2, 0.0)

@@ -1,4 +1,4 @@
-"""Heat capacities, Joule sources, thermal boundary conditions and time integrators.
+"""The transient (and steady) heat network: the theta-method integrator, its stability bound and results.
 
 The lumped heat balance of a packing (paper 000 eq. 13 and 16, paper 003 eq. 14):
 
@@ -42,491 +42,28 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, field
-from typing import Any, Optional, Sequence
+from typing import Optional, Sequence
 
 import numpy as np
 
+from ..core.errors import BoundaryConditionError, MaterialError, SolverError, ThermalError
+from ..core.graph import ContactGraph, edge_slots
+from ..core.materials import positive_property
+from ..laws.transmission import exposed_area
+from ..solvers.cg import CGSolver
+from ..solvers.base import DirectSolver
+from ..solvers.registry import make_solver
 from .condensation import ReducedSystem
-from .conductance import make_law
-from .errors import BoundaryConditionError, MaterialError, SolverError, ThermalError
-from .graph import ContactGraph
-from .materials import edge_conductivity, positive_property, real_number
-from .network import edge_power, edge_slots
-from .selection import check_selector, select_nodes
-from .solvers import CGSolver, DirectSolver, make_solver
+from .conditions import Convection, FixedTemperature, HeatFlux, boundary_value, resolve_conditions
+from .records import HeatStep, SteadyHeat, ThermalState, read_only_copy as _ro
+from .theta import theta_of
 
 _OWN_SOLVERS = (CGSolver, DirectSolver)
-from .surfaces import eccentricity, volume_fraction as _volume_fraction
 
-__all__ = ["heat_capacity", "edge_joule_power", "joule_sources", "electrical_power", "thermal_conductance",
-           "resolve_nodes", "resolve_area",
-           "exposed_area", "stable_time_step", "diffusion_time_step", "theta_of",
-           "FixedTemperature", "ThermalWall", "HeatFlux", "Convection", "HeatSource", "ThermalState", "HeatStep", "HeatSolver",
-           "SteadyHeat"]
+__all__ = ["HeatSolver"]
 
 log = logging.getLogger(__name__)
 
-_THETA_NAMES = {"explicit": 0.0, "forward-euler": 0.0, "crank-nicolson": 0.5,
-                "backward-euler": 1.0, "implicit": 1.0}
-
-
-# ---------------------------------------------------------------------------------------
-# material input
-# ---------------------------------------------------------------------------------------
-def heat_capacity(graph: ContactGraph, density, specific_heat, volume_fraction=None, cell_volume=None,
-                  threshold: float = 0.4, factor: float = 2.0) -> np.ndarray:
-    """Heat capacity C_i of every element [J/K].
-
-    ``C_i = rho c V_i / fv_i`` (paper 000 eq. 13), V_i the sphere volume and fv_i the volume
-    fraction of the continuum model (:func:`yade_electro.surfaces.volume_fraction`), so that
-    the element carries the heat capacity of the polyhedron it stands for.
-
-    Parameters
-    ----------
-    graph : ContactGraph
-    density : float or (n,) [kg/m^3], > 0
-    specific_heat : float or (n,) [J/(kg K)], > 0
-    volume_fraction : float or (n,), optional
-        Explicit fv_i (e.g. 1.0 for the paper's rod check); default from the bond graph.
-    cell_volume : (n,) array [m^3], optional
-        Volumes of the cells the elements stand for (e.g. Voronoi cells); then
-        ``C_i = rho c V_cell_i`` and ``volume_fraction`` must not be given.
-    threshold, factor : eccentricity rule of the default volume fraction.
-
-    Raises
-    ------
-    MaterialError
-        A non-positive or non-finite density, specific heat, volume fraction or cell volume.
-    """
-    n = graph.n_nodes
-    rc = positive_property("density", density, n, " (kg/m^3)") * positive_property("specific_heat", specific_heat, n,
-                                                                      " (J/(kg K))")
-    if cell_volume is not None:
-        if volume_fraction is not None:
-            raise ValueError("give volume_fraction= or cell_volume=, not both")
-        v = positive_property("cell_volume", cell_volume, n, " (m^3)")
-        return np.broadcast_to(rc * v, (n,)).astype(float)
-    if volume_fraction is None:
-        fv = _volume_fraction(graph, threshold=threshold, factor=factor)
-    else:
-        fv = positive_property("volume_fraction", volume_fraction, n)
-    return np.broadcast_to(rc * graph.volume / fv, (n,)).astype(float)
-
-
-def thermal_conductance(graph: ContactGraph, conductivity, law="continuum", **params) -> np.ndarray:
-    """Thermal conductance G_ij of every edge of ``graph`` [W/K]: ``lambda_edge g`` with the
-    law's geometric factor g (for 'continuum', ``lambda S_ij / l_ij``, paper 000 eq. 16);
-    per-node conductivities make an edge two half rods in series (harmonic mean).
-
-    Raises
-    ------
-    MaterialError
-        A non-positive or non-finite conductivity [W/(m K)].
-    """
-    lam = positive_property("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
-    return edge_conductivity(lam, graph.edges) * make_law(law, **params).factor(graph, graph.edges)
-
-
-def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_heat) -> float:
-    """Paper 000 eq. 14: ``l_min^2 / (2 alpha)`` [s], alpha = lambda / (rho c) (the largest
-    over the nodes when properties vary). For comparison with :func:`stable_time_step`,
-    which is the bound the integrators use."""
-    n = graph.n_nodes
-    alpha = (positive_property("thermal conductivity", conductivity, n) /
-             (positive_property("density", density, n) * positive_property("specific_heat", specific_heat, n)))
-    if graph.n_edges == 0:
-        return math.inf
-    return float(np.min(graph.length) ** 2 / (2.0 * np.max(alpha)))
-
-
-# ---------------------------------------------------------------------------------------
-# Joule heating
-# ---------------------------------------------------------------------------------------
-def edge_joule_power(branch_current, conductance, eta: float = 1.0) -> np.ndarray:
-    """Heat released in every edge, ``eta u_ij w_ij = eta w_ij^2 / c_ij`` [W] (paper 000
-    eq. 11); 0 on edges of zero conductance (they carry no current)."""
-    if not (0.0 <= eta <= 1.0):
-        raise ValueError(f"eta (share of the electrical power released as heat) must be in [0, 1], got {eta}")
-    w = np.asarray(branch_current, dtype=float)
-    c = np.asarray(conductance, dtype=float)
-    if w.shape != c.shape or w.ndim != 1:
-        raise ValueError(f"branch_current and conductance must be (m,) arrays of one shape, got {w.shape} "
-                         f"and {c.shape}")
-    return eta * edge_power(w, c)
-
-
-def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float = 1.0) -> np.ndarray:
-    """Joule power received by every node [W]: each edge's ``eta w^2 / c`` shared half and half
-    by its two end nodes. The total equals ``eta * sum_e V_e I_e`` over the electrodes
-    (:func:`electrical_power`) when no current is injected elsewhere."""
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    p = edge_joule_power(branch_current, conductance, eta)
-    if p.shape[0] != edges.shape[0]:
-        raise ValueError(f"one branch current per edge expected ({edges.shape[0]}), got {p.shape[0]}")
-    return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
-
-
-def electrical_power(solution) -> float:
-    """``sum_e V_e I_e`` over the electrodes of a PotentialSolution [W]: the power the external
-    circuit delivers (Tellegen: equals the total Joule power of the network)."""
-    return float(sum(solution.electrode_potential[k] * solution.electrode_current[k]
-                     for k in solution.electrode_current))
-
-
-# ---------------------------------------------------------------------------------------
-# boundary conditions
-# ---------------------------------------------------------------------------------------
-def exposed_area(graph: ContactGraph, threshold: float = 0.4) -> np.ndarray:
-    """Default exposed (free-surface) area A_i of every element [m^2] for convection and
-    surface fluxes: ``pi r_i^2`` where the eccentricity e_i > ``threshold`` (the elements the
-    continuum model treats as on the surface, f_i = 2), 0 elsewhere.
-
-    This is a crude estimate (one great-circle disc per surface element; the face elements
-    of a simple cubic lattice, e = 0.4 exactly, count as interior). When the surface
-    exchange matters, pass the areas yourself (``area=`` of :class:`Convection` /
-    :class:`HeatFlux`), e.g. the boundary faces of the Voronoi cells.
-    """
-    e = eccentricity(graph)
-    return np.where(e > threshold * (1.0 + 1e-9), np.pi * graph.radius ** 2, 0.0)
-
-
-def _finite(name, v):
-    try:
-        return real_number(name, v)
-    except MaterialError as exc:
-        raise BoundaryConditionError(str(exc)) from None
-
-
-def _check_bc(bc, kind):
-    if not isinstance(bc.name, str) or not bc.name:
-        raise BoundaryConditionError(f"{kind} boundary condition names must be non-empty strings, got {bc.name!r}")
-    surface = getattr(bc, "surface", None)
-    if surface is not None:
-        if bc.nodes is not None:
-            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (elements) or surface= "
-                                         "(a surface of the container), not both")
-        if getattr(bc, "area", None) is not None:
-            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: a surface condition takes its areas "
-                                         "from the boundary faces on the surface; do not give area=")
-        from .boundary import check_surface
-        check_surface(surface, f"{kind} boundary condition {bc.name!r}")
-        return
-    if bc.nodes is None:
-        raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (a selector: predicate, "
-                                     "ids, mask) or surface= (a surface of the container)")
-    check_selector(bc.nodes, f"{kind} boundary condition {bc.name!r}: nodes")
-    area = getattr(bc, "area", None)
-    if area is not None and not callable(area):
-        try:
-            a = np.asarray(area, dtype=float)
-        except (TypeError, ValueError):
-            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: area must be a number or an array "
-                                         f"of areas (m^2), got {area!r}") from None
-        if a.ndim > 1 or not np.all(np.isfinite(a)) or np.any(a < 0):
-            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: areas must be finite and >= 0 "
-                                         "(m^2), a scalar or one per element")
-
-
-def _required(bc, kind, field_, unit):
-    if getattr(bc, field_) is None:
-        raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give {field_}= ({unit})")
-
-
-@dataclass(frozen=True)
-class FixedTemperature:
-    """A fixed temperature [K or degC, as the model] on a node set or at a surface.
-
-    ``nodes``: node indices (HeatSolver), or, when a graph is given
-    (``HeatSolver.from_graph``, ``ElectroThermalModel``), anything
-    ``yade_electro.selection.select_nodes`` takes (callable, mask, graph ids): those
-    elements are held at ``temperature``. ``surface``: a surface of the container
-    (``shape.face('top')``, see :mod:`yade_electro.boundary`; needs ``ElectroThermalModel``):
-    the surface is held at ``temperature`` and each element with boundary faces on it
-    exchanges heat with it through its half cell, ``lambda sum_f A_f / d_f`` [W/K] (the
-    finite-volume Dirichlet condition). Give one of them."""
-
-    name: str
-    nodes: Any = None
-    temperature: float = None
-    surface: Any = None
-
-    def __post_init__(self):
-        _check_bc(self, "fixed-temperature")
-        _required(self, "fixed-temperature", "temperature", "K")
-        object.__setattr__(self, "temperature",
-                           _finite(f"fixed-temperature boundary condition {self.name!r}: temperature", self.temperature))
-
-
-@dataclass(frozen=True)
-class ThermalWall:
-    """A wall of a granular bed (a YADE ``Wall``, ``Box`` or facet mesh) for the heat model.
-
-    ``temperature`` [K]: the wall is isothermal at that value and every sphere touching it
-    exchanges ``G (T_wall - T_i)`` through the contact (G from the contact law with the
-    sphere-plane contact radius, :func:`yade_electro.contacts.plane_contact_radius`); None:
-    adiabatic (its contacts carry no heat). ``conductivity`` [W/(m K)]: the wall's material
-    (default the particles'); a contact takes the harmonic mean of the two, as a contact
-    between two particles of different materials does. The heat a wall gives goes into the
-    history (``wall_heat:<name>``, cumulative J) and into ``boundary_heat``."""
-
-    name: str
-    temperature: Optional[float] = None
-    conductivity: Optional[float] = None
-
-    def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise BoundaryConditionError(f"wall names must be non-empty strings, got {self.name!r}")
-        if self.temperature is not None:
-            object.__setattr__(self, "temperature", _finite(f"wall {self.name!r}: temperature", self.temperature))
-        if self.conductivity is not None:
-            lam = _finite(f"wall {self.name!r}: conductivity", self.conductivity)
-            if not lam > 0:
-                raise BoundaryConditionError(f"wall {self.name!r}: conductivity must be > 0 (W/(m K)), got {lam}")
-            object.__setattr__(self, "conductivity", lam)
-
-    @property
-    def isothermal(self) -> bool:
-        return self.temperature is not None
-
-
-@dataclass(frozen=True)
-class HeatFlux:
-    """Heat fed into a node set or through a surface: ``power`` [W] in total, shared in
-    proportion to ``area`` (equal shares when ``area`` is None), or ``flux`` [W/m^2] times
-    each node's ``area``. Negative values extract heat.
-
-    ``area``: scalar (every node) or (n,) array over all nodes [m^2]; None = equal shares
-    (power) or :func:`exposed_area` (flux, needs a graph). ``surface`` (instead of
-    ``nodes``): the elements with boundary faces on it, with their faces' areas."""
-
-    name: str
-    nodes: Any = None
-    power: Optional[float] = None
-    flux: Optional[float] = None
-    area: Any = None
-    surface: Any = None
-
-    def __post_init__(self):
-        _check_bc(self, "heat-flux")
-        if (self.power is None) == (self.flux is None):
-            raise BoundaryConditionError(f"heat-flux boundary condition {self.name!r}: give exactly one of power= "
-                                         "(W, total) or flux= (W/m^2)")
-        field_ = "power" if self.power is not None else "flux"
-        object.__setattr__(self, field_, _finite(f"heat-flux boundary condition {self.name!r}: {field_}",
-                                                 getattr(self, field_)))
-
-
-@dataclass(frozen=True)
-class Convection:
-    """Convection ``h A_i (t_inf - T_i)`` [W] on a node set: ``h`` [W/(m^2 K)] >= 0, ``t_inf`` the
-    ambient temperature, ``area`` scalar or (n,) [m^2] (None = :func:`exposed_area`).
-    ``surface`` (instead of ``nodes``): on the boundary faces of that surface of the
-    container, in series with each element's half cell: ``sum_f A_f / (1/h + d_f/lambda)``."""
-
-    name: str
-    nodes: Any = None
-    h: float = None
-    t_inf: float = None
-    area: Any = None
-    surface: Any = None
-
-    def __post_init__(self):
-        _check_bc(self, "convection")
-        _required(self, "convection", "h", "W/(m^2 K)")
-        _required(self, "convection", "t_inf", "K")
-        try:
-            h = real_number(f"convection boundary condition {self.name!r}: h", self.h)
-        except MaterialError as exc:
-            raise MaterialError(f"{exc} (W/(m^2 K))") from None
-        if h < 0:
-            raise MaterialError(f"convection boundary condition {self.name!r}: h must be >= 0 (W/(m^2 K)), got {h}")
-        object.__setattr__(self, "h", h)
-        object.__setattr__(self, "t_inf", _finite(f"convection boundary condition {self.name!r}: t_inf", self.t_inf))
-
-
-@dataclass(frozen=True)
-class HeatSource:
-    """A heat source inside the solid, on a node set (``nodes``; None = every element):
-    ``power`` [W] in total or ``density`` [W/m^3], shared in proportion to the elements'
-    volumes (the volumes the heat capacities stand for). Negative values are sinks."""
-
-    name: str
-    nodes: Any = None
-    power: Optional[float] = None
-    density: Optional[float] = None
-
-    def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise BoundaryConditionError(f"heat source names must be non-empty strings, got {self.name!r}")
-        if self.nodes is not None:
-            check_selector(self.nodes, f"heat source {self.name!r}: nodes")
-        if (self.power is None) == (self.density is None):
-            raise BoundaryConditionError(f"heat source {self.name!r}: give exactly one of power= (W, total) or "
-                                         "density= (W/m^3)")
-        field_ = "power" if self.power is not None else "density"
-        object.__setattr__(self, field_, _finite(f"heat source {self.name!r}: {field_}", getattr(self, field_)))
-
-
-def resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
-    """Node indices of a boundary condition's ``nodes`` (a selector with a graph, else node
-    indices or a mask); BoundaryConditionError when it selects nothing."""
-    if getattr(bc, "surface", None) is not None:
-        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r} is a surface: resolve it through "
-                                     "ElectroThermalModel (which knows the container), or give nodes=")
-    if graph is not None:
-        return select_nodes(graph, bc.nodes, bc.name, "thermal boundary condition")
-    if callable(bc.nodes):
-        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: a selector needs a graph; give "
-                                     "node indices or use HeatSolver.from_graph")
-    a = np.asarray(bc.nodes)
-    if a.dtype == bool:
-        if a.shape != (n,):
-            raise BoundaryConditionError(f"{bc.name!r}: mask has shape {a.shape}, expected ({n},)")
-        nodes = np.flatnonzero(a)
-    else:
-        nodes = np.unique(a.astype(np.int64).reshape(-1))
-        if nodes.size and (nodes.min() < 0 or nodes.max() >= n):
-            raise BoundaryConditionError(f"{bc.name!r}: node index out of range 0..{n - 1}")
-    if nodes.size == 0:
-        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r} selects no element")
-    return nodes
-
-
-def resolve_area(bc, nodes, n, default_area) -> np.ndarray:
-    if bc.area is None:
-        if default_area is None:
-            raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: no area given and no graph to "
-                                         "estimate the exposed area from; pass area= (m^2, scalar or per node)")
-        a = np.asarray(default_area, dtype=float)[nodes]
-    else:
-        a = np.asarray(bc.area, dtype=float)
-        if a.ndim == 0:
-            a = np.full(nodes.size, float(a))
-        elif a.shape == (n,):
-            a = a[nodes]
-        else:
-            raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: area must be a scalar or an ({n},) "
-                                         f"array, got shape {a.shape}")
-    if not np.all(np.isfinite(a)) or np.any(a < 0):
-        raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: areas must be finite and >= 0 (m^2)")
-    return a
-
-
-# ---------------------------------------------------------------------------------------
-# stability
-# ---------------------------------------------------------------------------------------
-def stable_time_step(capacity, edges, conductance, h_area=None, fixed=None) -> float:
-    """Largest forward-Euler step keeping the maximum principle [s]:
-    ``min_i C_i / (sum_j G_ij + h_i A_i)`` over the free nodes (``fixed`` a boolean mask of
-    fixed-temperature nodes); inf when no free node exchanges heat."""
-    C = np.asarray(capacity, dtype=float)
-    n = C.shape[0]
-    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    g = np.asarray(conductance, dtype=float)
-    d = np.bincount(e[:, 0], g, n) + np.bincount(e[:, 1], g, n)
-    if h_area is not None:
-        d = d + np.asarray(h_area, dtype=float)
-    free = np.ones(n, bool) if fixed is None else ~np.asarray(fixed, bool)
-    sel = free & (d > 0)
-    return float(np.min(C[sel] / d[sel])) if np.any(sel) else math.inf
-
-
-def theta_of(theta) -> float:
-    """theta from a number in [0, 1] or a name ('explicit', 'crank-nicolson', 'backward-euler')."""
-    if isinstance(theta, (bool, np.bool_)) or theta is None:
-        raise ValueError(f"theta must be 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1], "
-                         f"got {theta!r}")
-    if isinstance(theta, str):
-        try:
-            return _THETA_NAMES[theta.lower()]
-        except KeyError:
-            raise ValueError(f"unknown integrator {theta!r}; known: {', '.join(sorted(_THETA_NAMES))} "
-                             "or a number in [0, 1]") from None
-    try:
-        t = float(theta)
-    except (TypeError, ValueError):
-        raise ValueError(f"theta must be a name ({', '.join(sorted(_THETA_NAMES))}) or a number in [0, 1], "
-                         f"got {theta!r}") from None
-    if not (0.0 <= t <= 1.0):
-        raise ValueError(f"theta must be in [0, 1], got {theta}")
-    return t
-
-
-# ---------------------------------------------------------------------------------------
-# results
-# ---------------------------------------------------------------------------------------
-def _ro(a):
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
-
-
-@dataclass(frozen=True, eq=False)
-class ThermalState:
-    """Temperatures (n,) [K] at ``time`` [s] (a read-only copy)."""
-
-    temperature: np.ndarray
-    time: float
-
-
-@dataclass(frozen=True)
-class HeatStep:
-    """What one :meth:`HeatSolver.advance` did (energies in J over the step).
-
-    source_energy : the given sources (e.g. Joule) on free nodes, integrated over dt
-    absorbed_energy : given sources that fell on fixed-temperature nodes (taken by the thermostat)
-    flux_energy : imposed heat fluxes (HeatFlux)
-    convection_energy : heat received from the ambient by convection (negative when cooling)
-    boundary_energy : heat received from the fixed-temperature nodes
-    heat_change : sum_i C_i (T_i^{n+1} - T_i^n) over free nodes; equals the sum of the four
-        inputs above (to rounding) for every theta
-    """
-
-    time: float
-    dt: float
-    n_substeps: int
-    source_energy: float
-    absorbed_energy: float
-    flux_energy: float
-    convection_energy: float
-    boundary_energy: float
-    heat_change: float
-    info: dict = field(default_factory=dict, compare=False)
-
-    @property
-    def balance_error(self) -> float:
-        """|heat_change - inputs| / max(|terms|): a check of the integration's energy balance."""
-        inputs = self.source_energy + self.flux_energy + self.convection_energy + self.boundary_energy
-        scale = max(abs(self.heat_change), abs(self.source_energy), abs(self.flux_energy),
-                    abs(self.convection_energy), abs(self.boundary_energy)) or 1.0
-        return abs(self.heat_change - inputs) / scale
-
-
-@dataclass(frozen=True, eq=False)
-class SteadyHeat:
-    """A steady temperature field (:meth:`HeatSolver.steady`); powers in W.
-
-    temperature : (n,) [K]
-    source_power, flux_power : the given sources and the imposed fluxes / heat sources on free nodes
-    convection_power : heat received from the ambient (negative: lost to it)
-    boundary_power : heat received from the fixed temperatures (negative: taken by them)
-    iterations, residual : of the linear solve (relative residual)
-    """
-
-    temperature: np.ndarray
-    source_power: float
-    flux_power: float
-    convection_power: float
-    boundary_power: float
-    iterations: int
-    residual: float
-
-    @property
-    def balance_error(self) -> float:
-        """|sum of the powers| / max |power|: zero at the exact steady state."""
-        terms = (self.source_power, self.flux_power, self.convection_power, self.boundary_power)
-        return abs(sum(terms)) / (max(abs(t) for t in terms) or 1.0)
 
 
 # ---------------------------------------------------------------------------------------
@@ -618,87 +155,15 @@ class HeatSolver:
 
         # boundary conditions -> node sets and per-node arrays
         self.fixed_bcs, self.flux_bcs, self.convection_bcs = list(fixed), list(flux), list(convection)
-        names = [b.name for b in self.fixed_bcs + self.flux_bcs + self.convection_bcs]
-        if len(set(names)) != len(names):
-            raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
-        nodes_of = dict(nodes_of or {})
-        area_of, link_of = dict(area_of or {}), dict(link_of or {})
-
-        def nodes(bc):
-            if bc.name in nodes_of:
-                nd = np.asarray(nodes_of[bc.name], dtype=np.int64)
-                if bc.name in area_of or bc.name in link_of:
-                    return nd                   # aligned with its areas / conductances
-                return np.unique(nd)
-            return resolve_nodes(bc, n, graph)
-
-        def per_node(table, bc, nd, what):
-            a = np.asarray(table[bc.name], dtype=float)
-            if a.shape != nd.shape or not np.all(np.isfinite(a)) or np.any(a < 0):
-                raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: {what} must be finite, >= 0 "
-                                             f"and one per node of the condition ({nd.size})")
-            return a
-        owner = np.full(n, -1, dtype=np.int64)
-        self._fixed_nodes = {}
-        self._links = {}
-        for k, b in enumerate(self.fixed_bcs):
-            if b.name in link_of:
-                nd = nodes(b)
-                self._links[b.name] = (nd, per_node(link_of, b, nd, "link conductances (W/K)"))
-                continue
-            nd = nodes(b)
-            clash = nd[owner[nd] >= 0]
-            if clash.size:
-                raise BoundaryConditionError(
-                    f"{clash.size} element(s) are in both fixed-temperature boundary conditions "
-                    f"{self.fixed_bcs[owner[clash[0]]].name!r} and {b.name!r}; make them disjoint")
-            owner[nd] = k
-            self._fixed_nodes[b.name] = nd
+        r = resolve_conditions(n, self.fixed_bcs, self.flux_bcs, self.convection_bcs, graph=graph,
+                               default_area=default_area, nodes_of=nodes_of, area_of=area_of, link_of=link_of,
+                               power=power)
+        self._fixed_nodes, self._links, self.fixed = r.fixed_nodes, r.links, r.fixed
         self._fixed_value = {b.name: float(b.temperature) for b in self.fixed_bcs}
-        self.fixed = owner >= 0
-        self.fixed.setflags(write=False)
-        q = np.zeros(n)
-        for b in self.flux_bcs:
-            nd = nodes(b)
-            if b.name in area_of:
-                a = per_node(area_of, b, nd, "areas (m^2)")
-                if b.power is not None:
-                    if a.sum() <= 0:
-                        raise BoundaryConditionError(f"heat-flux boundary condition {b.name!r}: the areas sum to 0")
-                    np.add.at(q, nd, b.power * a / a.sum())
-                else:
-                    np.add.at(q, nd, b.flux * a)
-            elif b.power is not None:
-                if b.area is None:
-                    share = np.full(nd.size, 1.0 / nd.size)
-                else:
-                    a = resolve_area(b, nd, n, None)
-                    if a.sum() <= 0:
-                        raise BoundaryConditionError(f"heat-flux boundary condition {b.name!r}: the areas sum to 0")
-                    share = a / a.sum()
-                np.add.at(q, nd, b.power * share)
-            else:
-                np.add.at(q, nd, b.flux * resolve_area(b, nd, n, default_area))
-        if power is not None:
-            pw = np.asarray(power, dtype=float)
-            if pw.shape != (n,) or not np.all(np.isfinite(pw)):
-                raise BoundaryConditionError(f"power (heat sources) must be a finite ({n},) array (W per node)")
-            q += pw
-        hA, hAT = np.zeros(n), np.zeros(n)
-        for b in self.convection_bcs:
-            nd = nodes(b)
-            ha = b.h * (per_node(area_of, b, nd, "areas (m^2)") if b.name in area_of
-                        else resolve_area(b, nd, n, default_area))
-            np.add.at(hA, nd, ha)
-            np.add.at(hAT, nd, ha * b.t_inf)
-        hA[self.fixed] = 0.0
-        hAT[self.fixed] = 0.0
-        q[self.fixed] = 0.0
-        self._conv_hA, self._conv_hAT = hA, hAT
-        self.flux_power = _ro(q)
+        self._conv_hA, self._conv_hAT = r.h_area, r.h_area_t_inf
+        self.flux_power = _ro(r.power)
         self._refresh_links()
-        self.nodes_of = {**self._fixed_nodes, **{k: v[0] for k, v in self._links.items()},
-                         **{b.name: nodes(b) for b in self.flux_bcs + self.convection_bcs}}
+        self.nodes_of = r.nodes_of
 
         self._solver_spec = solver
         self._coords = None if coords is None else np.asarray(coords, dtype=float)
@@ -888,7 +353,7 @@ class HeatSolver:
         """Change the value of a fixed-temperature set (from the next step on)."""
         if name not in self._fixed_value:
             raise BoundaryConditionError(f"no fixed-temperature set named {name!r}; have {sorted(self._fixed_value)}")
-        self._fixed_value[name] = _finite(f"fixed temperature {name!r}", temperature)
+        self._fixed_value[name] = boundary_value(f"fixed temperature {name!r}", temperature)
         if name in self._links:
             self._refresh_links()
         else:
@@ -1088,7 +553,7 @@ class HeatSolver:
         the current temperatures when ``apply`` (the clock does not move). Raises ThermalError
         when some part of the network has no fixed temperature and no convection.
 
-        The linear solver is ``'auto'`` (:func:`yade_electro.solvers.auto_solver_name`: the
+        The linear solver is ``'auto'`` (:func:`yade_electro.solvers.registry.auto_solver_name`: the
         deflated CG from 80 unknowns on), kept across calls, to ``rtol`` relative residual."""
         n = self.n
         src = np.zeros(n) if sources is None else np.asarray(sources, dtype=float)
@@ -1137,15 +602,3 @@ class HeatSolver:
             self._T = T
             self._dT_prev = None
         return out
-
-    # -- construction from a graph ----------------------------------------------------------
-    @classmethod
-    def from_graph(cls, graph: ContactGraph, density, specific_heat, conductivity, temperature, *,
-                   law="continuum", law_params: Optional[dict] = None, volume_fraction=None,
-                   cell_volume=None, **kw) -> "HeatSolver":
-        """A solver on ``graph``: capacities by :func:`heat_capacity`, conductances by
-        :func:`thermal_conductance` with ``law``; other keywords go to the constructor."""
-        C = heat_capacity(graph, density, specific_heat, volume_fraction=volume_fraction, cell_volume=cell_volume)
-        G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
-        kw.setdefault("coords", graph.pos)
-        return cls(C, graph.edges, G, temperature, graph=graph, **kw)

@@ -252,3 +252,21 @@ class ContactGraph:
         """A new graph with the same elements and only the edges where ``keep_edges`` is true."""
         keep = np.asarray(keep_edges, dtype=bool)
         return self.with_edges(self.edges[keep], shift=None if self.shift is None else self.shift[keep])
+
+
+def edge_slots(candidates, edges, n_nodes: int):
+    """Positions of the node pairs ``edges`` among ``candidates`` (both (m, 2), any order within a
+    pair), or None when some pair is not a candidate."""
+    c = np.sort(np.asarray(candidates, dtype=np.int64).reshape(-1, 2), axis=1)
+    e = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
+    if e.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    if c.shape[0] == 0:
+        return None
+    kc = c[:, 0] * n_nodes + c[:, 1]
+    ke = e[:, 0] * n_nodes + e[:, 1]
+    order = np.argsort(kc)
+    pos = np.clip(np.searchsorted(kc[order], ke), 0, kc.size - 1)
+    if not np.all(kc[order][pos] == ke):
+        return None
+    return order[pos]

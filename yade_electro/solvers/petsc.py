@@ -33,8 +33,8 @@ from typing import Optional
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import SolverError
-from .solvers import Solver
+from ..core.errors import SolverError
+from .base import Solver
 
 __all__ = ["PETScSolver", "import_petsc", "petsc_available"]
 

@@ -6,7 +6,7 @@ Structure and values are kept apart: g depends on the geometry only, so
 * the electrical conductance is ``c = g / rho_edge`` [S] (:func:`conductance`),
 * the thermal conductance is ``G = lambda_edge g`` [W/K],
 
-with the per-edge material of :mod:`yade_electro.materials` (mean resistivity, harmonic mean
+with the per-edge material of :mod:`yade_electro.core.materials` (mean resistivity, harmonic mean
 conductivity: two half rods in series). A change of temperature (rho_e(T)) changes values only;
 a move of the elements changes g, never the structure.
 
@@ -27,8 +27,8 @@ continuum
     elements, 2).
 voronoi
     Faces of the Voronoi tessellation of the element centres, bounded by the solid's
-    ``container`` (a :class:`yade_electro.geometry.Shape`): g = A_ij / l_ij, exact for uniform
-    fields (see :mod:`yade_electro.voronoi`). Cracks (``crack='facets'``, the default): a face
+    ``container`` (a :class:`yade_electro.geometry.shapes.Shape`): g = A_ij / l_ij, exact for uniform
+    fields (see :mod:`yade_electro.geometry.voronoi`). Cracks (``crack='facets'``, the default): a face
     of a pair bonded in the reference conducts while its bond is intact; a face of an unbonded
     pair conducts while its elements are linked by at most ``hops`` (3) intact bonds and no
     broken bond's *facet* (its own Voronoi face) lies across the segment between them. ``crack='paths'`` is the earlier rule
@@ -49,11 +49,11 @@ from typing import Callable, Dict
 
 import numpy as np
 
-from .contacts import native_helper
-from .errors import MaterialError
-from .graph import ContactGraph
-from .materials import edge_resistivity, positive_property
-from .surfaces import edge_transmission_surface, polyhedron_alpha
+from ..geometry.contacts import native_helper
+from ..core.errors import MaterialError
+from ..core.graph import ContactGraph
+from ..core.materials import edge_resistivity, positive_property
+from .transmission import edge_transmission_surface, polyhedron_alpha
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
            "check_law_name", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
@@ -127,7 +127,7 @@ def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     f = native_helper("pair_lengths")
     if f is not None and (graph.shift is None or edges is graph.edges):
-        from .native import NativeError
+        from ..native import NativeError
         try:
             length, zero = f(graph.pos, edges, graph.shift)
         except NativeError:
@@ -182,7 +182,7 @@ class ContinuumLaw(ConductanceLaw):
             raise ValueError("the continuum law conducts through the bonds of the graph only")
         f = native_helper("continuum_factors")
         if f is not None and graph.shift is None:
-            from .native import NativeError
+            from ..native import NativeError
             try:
                 g, coincident = f(graph.pos, graph.radius, polyhedron_alpha(graph.degree) * graph.radius ** 2,
                                   graph.edges, self.threshold, self.factor_)
@@ -218,7 +218,7 @@ def contact_radius(graph: ContactGraph, edges=None, model: str = "geometric") ->
     edges = graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     f = native_helper("contact_radii")
     if f is not None and (graph.shift is None or edges is graph.edges):
-        from .native import NativeError
+        from ..native import NativeError
         try:
             a, coincident = f(graph.pos, graph.radius, edges, graph.shift, model)
         except NativeError:
@@ -287,7 +287,7 @@ class GranularLaw(ConductanceLaw):
 
     def wall_factor(self, radius, overlap) -> np.ndarray:
         """g [m] of spheres of ``radius`` pressed by ``overlap`` into a wall (a plane)."""
-        from .contacts import plane_contact_radius
+        from ..geometry.contacts import plane_contact_radius
         return self.SHAPE * self._scale * plane_contact_radius(radius, overlap, self.radius)
 
 
@@ -356,7 +356,7 @@ class PipeLaw(GranularLaw):
         return np.where(a > 0, np.pi * self.width / f, 0.0)
 
     def wall_factor(self, radius, overlap) -> np.ndarray:
-        from .contacts import plane_contact_radius
+        from ..geometry.contacts import plane_contact_radius
         r = np.asarray(radius, float)
         a = self._scale * plane_contact_radius(r, overlap, self.radius)
         al = np.arcsin(np.clip(a / r, 0.0, 1.0))
@@ -374,7 +374,7 @@ class VoronoiLaw(ConductanceLaw):
     def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets"):
         if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
             raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
-                             "and gradient(x) (e.g. yade_electro.geometry.as_shape(predicate)); "
+                             "and gradient(x) (e.g. yade_electro.geometry.shapes.as_shape(predicate)); "
                              f"got {container!r}")
         if isinstance(hops, bool) or int(hops) != hops or hops < 1:
             raise ValueError(f"hops must be an integer >= 1, got {hops!r}")
@@ -396,7 +396,7 @@ class VoronoiLaw(ConductanceLaw):
         of the set."""
         key = graph.ids.tobytes()
         if self._key != key:
-            from .voronoi import VoronoiFaces
+            from ..geometry.voronoi import VoronoiFaces
             ref = self.reference
             if ref is not None and ref[0].shape == graph.ids.shape and np.array_equal(ref[0], graph.ids):
                 bonds = ref[3] if len(ref) > 3 else graph.edges
@@ -487,7 +487,7 @@ class FactorNetwork:
         self._pos = self._shift = self._radius = None
 
     def update(self, graph: ContactGraph):
-        from .network import edge_slots
+        from ..core.graph import edge_slots
         old = self.graph
         if old is not None and graph is old:
             return None

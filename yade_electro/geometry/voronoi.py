@@ -202,9 +202,9 @@ def _tessellate(pos, radius, ghosts):
 
 
 def _progress_lines(n_points):
-    """A progress callback for the qhull slabs (:class:`yade_electro.progress.Progress`: a
+    """A progress callback for the qhull slabs (:class:`yade_electro.core.progress.Progress`: a
     line on stderr at most every PROGRESS_EVERY s, with the slabs done and the time left)."""
-    from .progress import Progress
+    from ..core.progress import Progress
     report = Progress("voronoi", f"{n_points:,} points, slabs tessellated")     # the clock starts here
 
     def progress(done, total, elapsed):
@@ -308,7 +308,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     boundary faces, from one tessellation (see the module doc for the ghosts).
 
     Cells with a vertex outside the container by more than ``rel_tol * 2 r_min`` are clipped,
-    all at once (:mod:`yade_electro.clipping`), by the container's tangent planes at the
+    all at once (:mod:`yade_electro.geometry.clipping`), by the container's tangent planes at the
     nearest surface points of their outside vertices (the farthest ``planes_per_round``
     of each cell per round), round after round (at most ``max_rounds``) until no vertex is
     outside by more than ``rel_tol`` times the cell's size (defaults: 3e-3, 2 planes, 4
@@ -649,7 +649,7 @@ class VoronoiFaces:
         powers of the sparse adjacency matrix (a matrix of every node's ``hops`` ball:
         about 60 entries per node at 3 hops on a lattice)."""
         import scipy.sparse as sp
-        from .native import NativeError, hops_linked
+        from ..native import NativeError, hops_linked
         n = self.n
         b = np.asarray(bonds, dtype=np.int64).reshape(-1, 2)
         try:
@@ -862,7 +862,7 @@ def voronoi_cell_volumes(pos, radius, container, rel_tol: float = 3e-3, return_i
     ----------
     pos : (n, 3) element centres [m]
     radius : (n,) radii [m] (set the width of the band of mirrored elements)
-    container : object with ``sdf`` and ``gradient`` (a :mod:`yade_electro.geometry` shape)
+    container : object with ``sdf`` and ``gradient`` (a :mod:`yade_electro.geometry.shapes` shape)
     rel_tol : clipping tolerance (see :func:`bounded_cells`)
     return_info : bool
         Also return a dict: ``total`` (sum of the volumes), ``container_volume`` (exact if

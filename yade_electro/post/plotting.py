@@ -1,6 +1,6 @@
 """Plots of an engine's history (matplotlib, Agg backend; imported only when called).
 
-    from yade_electro.plotting import plot_history
+    from yade_electro.post.plotting import plot_history
     plot_history("electrothermal.csv", "history.png")       # or an engine's .history
 
 The figure has one panel per group of columns present in the history: resistance, current,

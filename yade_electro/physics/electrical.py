@@ -26,16 +26,18 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
-from .contacts import new_wall_contacts
-from .conductance import ConductanceLaw, FactorNetwork, make_law
-from .errors import BoundaryConditionError
-from .graph import ContactGraph
-from .materials import Material, edge_resistivity, positive_property
-from .network import ConductionProblem, Electrode, PotentialSolution, electrode_value
-from .selection import Membership, Selector, check_selector, select_nodes
-from .solvers import check_solver_name
+from ..geometry.contacts import new_wall_contacts
+from ..laws.conductance import ConductanceLaw, FactorNetwork, make_law
+from ..core.errors import BoundaryConditionError
+from ..core.graph import ContactGraph
+from ..core.materials import Material, edge_resistivity, positive_property
+from ..network.conduction import ConductionProblem
+from ..network.records import PotentialSolution
+from ..network.kirchhoff import Electrode, electrode_value
+from ..core.selection import Membership, Selector, check_selector, select_nodes
+from ..solvers.registry import check_solver_name
 
-__all__ = ["ElectrodeSpec", "ElectricalModel", "select_nodes", "electrode_specs"]
+__all__ = ["ElectrodeSpec", "ElectricalModel", "electrode_specs"]
 
 log = logging.getLogger(__name__)
 
@@ -47,7 +49,7 @@ class ElectrodeSpec:
 
     ``select``: the element layer the electrode is (paper 000's convention: a perfect conductor
     through the selected elements' centres). ``surface``: a surface of the container (e.g.
-    ``container.face('top')``, see :mod:`yade_electro.boundary`): the electrode is that surface,
+    ``container.face('top')``, see :mod:`yade_electro.geometry.surface_contact`): the electrode is that surface,
     each element with boundary faces on it connected through its half cell. ``wall=True``: a
     wall of a granular bed (a plate), each particle touching it connected through its contact
     (the contact law's sphere-wall factor, :meth:`ElectricalModel.set_wall_contacts` gives the
@@ -71,7 +73,7 @@ class ElectrodeSpec:
                                          "or a mask), surface= (a surface of the container) or wall= (a wall of a "
                                          "granular bed), one of them")
         if self.surface is not None:
-            from .boundary import check_surface
+            from ..geometry.surface_contact import check_surface
             check_surface(self.surface, f"electrode {self.name!r}")
         elif not self.wall:
             check_selector(self.select, f"electrode {self.name!r}: select")
@@ -131,13 +133,13 @@ class ElectricalModel:
         Electrical resistivity rho_e [ohm m], > 0 (304L steel: 0.73e-6), or a Material.
     electrodes : mapping name -> dict(select=..., potential=V | current=A), or ElectrodeSpecs
     law : str or ConductanceLaw
-        Conductance law name (``yade_electro.conductance.conductance_laws()``).
+        Conductance law name (``yade_electro.laws.conductance.conductance_laws()``).
     law_params : dict, optional
         Parameters of the law (``container`` for 'voronoi'; ``threshold``, ``factor`` for
         'continuum').
     solver : str or solver object
         'auto' (by size), 'cg', 'cg-deflated', 'cg-amg', 'direct' or an object with
-        ``solve(A, b, x0=None) -> (x, info)`` (see :mod:`yade_electro.solvers`).
+        ``solve(A, b, x0=None) -> (x, info)`` (see :mod:`yade_electro.solvers.registry`).
     measure : (str, str), optional
         Electrodes between which R_eq is reported; default the first two.
     reselect : bool
@@ -179,7 +181,7 @@ class ElectricalModel:
         self._wall_nodes = {}                 # name -> the nodes of its edges in the kept problem
         self._walls_stale = False
         self.container = container if container is not None else getattr(self.law, "container", None)
-        from .boundary import BoundaryOfGraph, SurfaceMembership
+        from ..geometry.surface_contact import BoundaryOfGraph, SurfaceMembership
         self.surfaces: Dict[str, SurfaceMembership] = {s.name: SurfaceMembership(s.name, s.surface)
                                                        for s in self.specs if s.surface is not None}
         self._boundary = None
@@ -274,7 +276,7 @@ class ElectricalModel:
     def element_joule_power(self, eta: float = 1.0) -> np.ndarray:
         """Joule heat [W] per element: each network edge's eta w^2 / c shared half and half by
         its ends, a surface half cell's given to its element."""
-        from .network import edge_power
+        from ..network.kirchhoff import edge_power
         n, m = self.n_elements, self.network.edges.shape[0]
         p = eta * edge_power(self.solution.branch_current, self.conductance)
         e = self.network.edges
@@ -380,7 +382,7 @@ class ElectricalModel:
     def update(self, graph: ContactGraph) -> Optional[str]:
         """Bring the kept problem to ``graph``; returns what changed: None, 'resistivity',
         'geometry', 'topology' or 'structure' (see the module doc and
-        :class:`~yade_electro.conductance.FactorNetwork`)."""
+        :class:`~yade_electro.laws.conductance.FactorNetwork`)."""
         if not isinstance(graph, ContactGraph):
             raise TypeError(f"expected a ContactGraph, got {type(graph).__name__}")
         kind = self.network.update(graph)

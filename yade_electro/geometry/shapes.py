@@ -20,6 +20,8 @@ import time
 
 import numpy as np
 
+from .surfaces import OnSurface, Plane, SurfaceSelector
+
 __all__ = ["Shape", "Cylinder", "Box", "Sphere", "Difference", "Intersection", "Union", "GridShape",
            "as_shape", "container_volume"]
 
@@ -446,7 +448,7 @@ class GridShape(Shape):
     def wall_curvature(self, x, h=None):
         """Zero [1/m]: a field interpolated trilinearly from voxels has no usable second
         derivative, so the walls of a sampled shape are taken as flat (surface conditions on
-        them get no curvature correction; see :mod:`yade_electro.boundary`)."""
+        them get no curvature correction; see :mod:`yade_electro.geometry.surface_contact`)."""
         return np.zeros(_pts(x).shape[0])
 
     def key(self):
@@ -551,55 +553,6 @@ def container_volume(shape, n_samples=4_000_000, seed=20240607) -> tuple:
     return float(np.prod(hi - lo) * hits / n_samples), f"monte-carlo(n={n_samples}, seed={seed})"
 
 
-# =========================================================================================
-# Surfaces: which boundary faces a surface boundary condition acts on
-# =========================================================================================
-class SurfaceSelector:
-    """Picks boundary faces (a point on each and its outward normal) that lie on a surface.
-
-    ``SurfaceSelector(fn)`` wraps ``fn(points (b, 3), normals (b, 3)) -> bool mask``. Made by
-    :class:`Plane`, ``Shape.face(name)``, ``Shape.surface()`` and :func:`as_surface`.
-    """
-
-    def __init__(self, fn, description="surface"):
-        self.fn, self.description = fn, description
-
-    def __call__(self, points, normals) -> np.ndarray:
-        return np.asarray(self.fn(np.asarray(points, float), np.asarray(normals, float)), dtype=bool)
-
-    def __repr__(self):
-        return self.description
-
-
-class Plane(SurfaceSelector):
-    """The faces on the plane through ``point`` with outward ``normal`` (within ``tol`` [m]),
-    facing the same way (normal . n > 0.5)."""
-
-    def __init__(self, point, normal, tol):
-        self.point = np.asarray(point, float).reshape(3)
-        n = np.asarray(normal, float).reshape(3)
-        if not np.linalg.norm(n) > 0:
-            raise ValueError("a Plane needs a non-zero normal")
-        self.normal = n / np.linalg.norm(n)
-        self.tol = float(tol)
-        if not self.tol > 0:
-            raise ValueError(f"a Plane needs tol > 0 [m], got {tol}")
-        super().__init__(self._select, f"Plane(point={tuple(self.point)}, normal={tuple(self.normal)})")
-
-    def _select(self, points, normals):
-        return (np.abs((points - self.point) @ self.normal) <= self.tol) & (normals @ self.normal > 0.5)
-
-
-class OnSurface(SurfaceSelector):
-    """The faces on a shape's boundary (|sdf| <= tol)."""
-
-    def __init__(self, shape, tol=None):
-        lo, hi = shape.bounds()
-        self.shape = shape
-        self.tol = float(tol) if tol is not None else 1e-6 * float(np.max(hi - lo))
-        super().__init__(lambda p, n: np.abs(shape.sdf(p)) <= self.tol, f"{shape!r}.surface()")
-
-
 def as_surface(surface) -> SurfaceSelector:
     """A surface selector from a SurfaceSelector, a callable ``f(points, normals) -> mask``,
     or a region (a Shape or YADE predicate: the faces whose centre lies inside it)."""
@@ -618,5 +571,5 @@ def as_surface(surface) -> SurfaceSelector:
                      f"predicate holding the faces) or a callable f(points, normals) -> mask; got {surface!r}")
 
 
-__all__ += ["SurfaceSelector", "Plane", "OnSurface", "as_surface"]
+__all__ += ["as_surface"]
 

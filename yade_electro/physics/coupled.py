@@ -1,7 +1,7 @@
 """Electro-thermal coupling: potential -> Joule sources -> heat step, one call per period.
 
-:class:`ElectroThermalModel` joins an :class:`~yade_electro.electrical.ElectricalModel` (or no
-electrical model: heat conduction only) and a :class:`~yade_electro.thermal.HeatSolver` and
+:class:`ElectroThermalModel` joins an :class:`~yade_electro.physics.electrical.ElectricalModel` (or no
+electrical model: heat conduction only) and a :class:`~yade_electro.network.transient.HeatSolver` and
 keeps both across calls of ``step(graph, dt)``. One geometric factor g per edge serves the
 electrical conductance (g / rho_e), the thermal conductance (lambda g), the Joule heat and the
 history. What a call costs depends on what changed:
@@ -36,17 +36,20 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
-from .contacts import new_wall_contacts
-from .conductance import FactorNetwork, make_law
+from ..geometry.contacts import new_wall_contacts
+from ..laws.conductance import FactorNetwork, make_law
 from .electrical import ElectricalModel
-from .errors import MaterialError
-from .graph import ContactGraph
-from .history import History
-from .materials import Material, edge_conductivity, real_number
-from .selection import Membership
-from .boundary import BoundaryOfGraph, SurfaceMembership
-from .thermal import (Convection, FixedTemperature, HeatFlux, HeatSolver, HeatSource, ThermalWall,
-                      diffusion_time_step, heat_capacity, theta_of)
+from ..core.errors import MaterialError
+from ..core.graph import ContactGraph
+from ..core.history import History
+from ..core.materials import Material, edge_conductivity, real_number
+from ..core.selection import Membership
+from ..geometry.surface_contact import BoundaryOfGraph, SurfaceMembership
+from ..network.conditions import Convection, FixedTemperature, HeatFlux
+from ..network.transient import HeatSolver
+from ..network.theta import theta_of
+from ..network.conditions import HeatSource, ThermalWall
+from .thermal import diffusion_time_step, heat_capacity
 
 __all__ = ["ElectroThermalModel"]
 
@@ -81,7 +84,7 @@ class ElectroThermalModel:
     fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
         Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
         on the first graph and then kept by element id; or ``surface=`` a surface of the
-        ``container`` (see :mod:`yade_electro.boundary`): a fixed temperature then acts through
+        ``container`` (see :mod:`yade_electro.geometry.surface_contact`): a fixed temperature then acts through
         the touching elements' half cells, a flux on their boundary faces' areas, convection
         on those areas in series with the half cells.
     sources : sequence of HeatSource, optional
@@ -90,7 +93,7 @@ class ElectroThermalModel:
         The solid, for surface conditions (default: the electrical model's, or the law's).
     area : callable(graph) -> (n,) exposed areas [m^2], optional
         Default area of convection/flux conditions (else ``thermal.exposed_area``).
-    volume_fraction, cell_volume : optional, see :func:`~yade_electro.thermal.heat_capacity`
+    volume_fraction, cell_volume : optional, see :func:`~yade_electro.network.transient.heat_capacity`
         Scalars or callables ``f(graph) -> (n,)``. Default: paper 000's fv(n) capacities,
         except with the 'voronoi' law, where its bounded Voronoi cell volumes are used.
     coupling_iterations, coupling_tol, resistivity_tol : see the module notes.
@@ -112,7 +115,7 @@ class ElectroThermalModel:
                  resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None,
                  sources: Sequence[HeatSource] = (), container=None, walls: Sequence[ThermalWall] = ()):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
-            raise TypeError("electrical must be an ElectricalModel (yade_electro.electrical) or None")
+            raise TypeError("electrical must be an ElectricalModel (yade_electro.physics.electrical) or None")
         self.electrical = electrical
         self.initial_temperature = real_number("temperature (K)", temperature)
         T0 = self.initial_temperature if reference_temperature is None else reference_temperature
@@ -136,7 +139,7 @@ class ElectroThermalModel:
                     raise TypeError(f"expected {cls.__name__} objects, got {bc!r}")
         names = [b.name for b in self.fixed + self.flux + self.convection]
         if len(set(names)) != len(names):
-            from .errors import BoundaryConditionError
+            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
         self.heat_sources = list(sources)
         for src in self.heat_sources:
@@ -146,10 +149,10 @@ class ElectroThermalModel:
         self.walls = list(walls)
         for w in self.walls:
             if not isinstance(w, ThermalWall):
-                raise TypeError(f"expected ThermalWall objects (yade_electro.thermal) in walls=, got {w!r}")
+                raise TypeError(f"expected ThermalWall objects (yade_electro.network.transient) in walls=, got {w!r}")
         names += [w.name for w in self.walls]
         if len(set(names)) != len(names):
-            from .errors import BoundaryConditionError
+            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition and heat source names must be unique, got {names}")
         everything = self.fixed + self.flux + self.convection
         self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition")
@@ -165,7 +168,7 @@ class ElectroThermalModel:
             try:
                 law_.wall_factor(np.ones(1), np.zeros(1))
             except ValueError as exc:
-                from .errors import BoundaryConditionError
+                from ..core.errors import BoundaryConditionError
                 raise BoundaryConditionError(f"walls= given with law {law_.name!r}: {exc}") from None
         self._wall_contacts = {w.name: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
         self._walls_applied = None
@@ -290,7 +293,7 @@ class ElectroThermalModel:
         """The spheres touching wall ``name`` now (node indices of the next step's graph) and
         their overlaps [m] (> 0); applied at the next step."""
         if name not in self._wall_contacts:
-            from .errors import BoundaryConditionError
+            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"no wall named {name!r}; have {sorted(self._wall_contacts)}")
         new = new_wall_contacts(f"wall {name!r}", self._wall_contacts[name], nodes, overlap)
         if new is None:

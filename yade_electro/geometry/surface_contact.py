@@ -1,10 +1,10 @@
 """Boundary faces of a packing and surface boundary conditions: which elements a surface of the
 container touches, through what area, at what distance.
 
-The bounded Voronoi cells of a packing (:func:`yade_electro.voronoi.bounded_cells`) close on
+The bounded Voronoi cells of a packing (:func:`yade_electro.geometry.voronoi.bounded_cells`) close on
 the container's surface with *boundary faces* (area, outward normal, centroid). A surface
 boundary condition acts on the boundary faces a surface selector picks
-(:mod:`yade_electro.geometry`: ``shape.face('top')``, ``Plane``, a region, a callable):
+(:mod:`yade_electro.geometry.shapes`: ``shape.face('top')``, ``Plane``, a region, a callable):
 
 * an electrode (or a fixed temperature) at a surface connects each element with faces on it
   through the *half-cell* conductance: the finite-volume Dirichlet condition,
@@ -27,8 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import BoundaryConditionError
-from .geometry import as_surface
+from ..core.errors import BoundaryConditionError
+from .shapes import as_surface
 
 __all__ = ["SurfaceContact", "surface_contact", "half_cell_length", "SavedSurface", "SurfaceMembership",
            "check_surface", "boundary_areas", "BoundaryOfGraph"]
@@ -114,7 +114,7 @@ def half_cell_length(depth, curvature):
 def surface_contact(cells, pos, surface, name: str = "surface", what: str = "electrode",
                     container=None) -> SurfaceContact:
     """The elements of ``cells`` (BoundedCells of the elements at ``pos``) whose boundary faces
-    lie on ``surface`` (see :func:`yade_electro.geometry.as_surface`); raises
+    lie on ``surface`` (see :func:`yade_electro.geometry.shapes.as_surface`); raises
     BoundaryConditionError when it touches none. With the ``container`` (a Shape), each
     face's half cell is corrected for the wall's curvature there (:func:`half_cell_length`);
     without it the wall is taken as flat."""

@@ -250,7 +250,7 @@ def _edges_of(s, keep_lo, N):
 
 def _whole_cgal(points, n_real):
     """CGAL's triangulation, with the faces' polygons already in cyclic order."""
-    from .native import cgal_delaunay
+    from ..native import cgal_delaunay
     N = points.shape[0]
     s, cgal_cc, pairs, counts, around = cgal_delaunay(points, n_real)
     # circumcentres by our formula (relative to a vertex); with CGAL's inexact construction
@@ -302,12 +302,12 @@ def tessellate(points, n_real: int, n_far: int = 0, slab_points: int = SLAB_POIN
     N = points.shape[0]
     body = N - n_far
     if backend is None:
-        from .native import delaunay_backend
+        from ..native import delaunay_backend
         backend = delaunay_backend(body)
     if backend not in ("cgal", "qhull"):
         raise ValueError(f"backend must be 'cgal' or 'qhull', got {backend!r}")
     if backend == "cgal":
-        from .native import NativeError
+        from ..native import NativeError
         try:
             return _whole(points, n_real, "cgal")
         except NativeError as exc:               # coinciding points: qhull copes with them

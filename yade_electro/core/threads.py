@@ -4,7 +4,7 @@ The solvers' work is sparse products (scipy, one thread) and vector reductions (
 that numpy hands to OpenBLAS. Inside ``yade`` OpenBLAS runs one thread; in a plain
 ``python3`` on this 2-core machine it starts two, and the CG got 1.1-4x slower from the
 threads' start-up on every short reduction (measured before this module; README *Scale*).
-So importing :mod:`yade_electro.solvers` holds OpenBLAS to ``YADE_ELECTRO_BLAS_THREADS``
+So importing :mod:`yade_electro.solvers.registry` holds OpenBLAS to ``YADE_ELECTRO_BLAS_THREADS``
 threads (default 1) through OpenBLAS' own ``openblas_set_num_threads``, found in the
 libraries this process has loaded (as threadpoolctl does). Set the variable to ``0`` to
 leave OpenBLAS as it is.

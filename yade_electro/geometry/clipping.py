@@ -8,7 +8,7 @@ over all faces, and closes each cut polytope with its cap: the polygon of the cr
 points, ordered around their centre. Volumes are the pyramids from a point inside each
 polytope (its seed) on its faces.
 
-Used by :mod:`yade_electro.voronoi` to bound the Voronoi cells of a packing by its container
+Used by :mod:`yade_electro.geometry.voronoi` to bound the Voronoi cells of a packing by its container
 (cells, faces and boundary faces in one pass).
 
 Units: those of the coordinates (metres, m^2, m^3).

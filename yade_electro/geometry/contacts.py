@@ -127,7 +127,7 @@ def periodic_candidate_pairs(pos, radius, skin: float, cell):
     cell narrower than twice the search distance 2 r_max + skin (where a pair could touch
     through two images) raises GraphError."""
     import itertools
-    from .errors import GraphError
+    from ..core.errors import GraphError
     pos = np.asarray(pos, dtype=float)
     radius = np.asarray(radius, dtype=float)
     H = np.asarray(cell, dtype=float).reshape(3, 3)
@@ -192,7 +192,7 @@ def _cell_pairs(pos, cut):
     cells = np.prod(np.maximum(1.0, np.floor(span / cut)))
     if not np.isfinite(cells) or cells > 8 * pos.shape[0] + 4096:
         return None                      # a sparse box (spheres far apart): the tree is better
-    from .native import FireSteps, NativeError
+    from ..native import FireSteps, NativeError
     try:
         if not _CELLS:
             _CELLS.append(FireSteps(threads=1))
@@ -295,7 +295,7 @@ def native_helper(name):
     cannot be built or is switched off (``NATIVE = False``, for tests)."""
     if not NATIVE:
         return None
-    from . import native
+    from .. import native
     return getattr(native, name)
 
 
@@ -324,7 +324,7 @@ def facet_vertices(pos, quat, local) -> np.ndarray:
     microseconds, where these numpy operations take about 0.2 ms) where it builds."""
     f = native_helper("facet_vertices")
     if f is not None:
-        from .native import NativeError
+        from ..native import NativeError
         try:
             return f(pos, quat, local)
         except NativeError:
@@ -344,7 +344,7 @@ def triangle_distance(points, triangles) -> np.ndarray:
     regions and precedence) where it builds, else numpy."""
     f = native_helper("triangle_distance")
     if f is not None:
-        from .native import NativeError
+        from ..native import NativeError
         try:
             return f(points, triangles)
         except NativeError:
@@ -414,7 +414,7 @@ def wall_candidates(wall: WallGeometry, pos, radius, skin: float, tree=None):
     reach = rc + float(radius.max()) + float(skin)
     f = native_helper("triangle_candidates")
     if f is not None and tree is None:
-        from .native import NativeError
+        from ..native import NativeError
         try:
             return f(pos, radius, skin, wall.vertices, c, reach)
         except NativeError:

@@ -15,7 +15,7 @@ unknowns ``u``, and
 the edge values to their CSR data. :meth:`ReducedSystem.assemble` then fills the data of the
 *same* matrix objects from new edge values (K_uu by one compiled pass, numpy's scatter and
 incidence product when it cannot be built; K_ud, K_dd by a sparse mat-vec each), so that solvers keep
-their setup (see :mod:`yade_electro.solvers`) and a change of values never rebuilds structure.
+their setup (see :mod:`yade_electro.solvers.registry`) and a change of values never rebuilds structure.
 """
 from __future__ import annotations
 
@@ -44,7 +44,7 @@ def _pattern(rows, cols, shape, native: bool = False):
     rows = np.asarray(rows)
     N = rows.size
     if native and N:
-        from .native import NativeError, csr_pattern
+        from ..native import NativeError, csr_pattern
         try:
             got = csr_pattern(rows, cols, shape)
         except NativeError:
@@ -233,7 +233,7 @@ class ReducedSystem:
         asked for or cannot be built (then numpy)."""
         if not self._native:
             return False
-        from .native import NativeError, laplacian_fill
+        from ..native import NativeError, laplacian_fill
         o1, o2 = self._off
         try:
             laplacian_fill(self.Kuu.data, c, self._e_uu, o1, o2, self.diagonal_slots, self._incidence, diagonal)

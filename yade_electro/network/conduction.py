@@ -8,7 +8,7 @@ currents injected into the nodes [A].
 
 Electrodes are node sets tied by a perfect conductor (one potential for all of them), either
 held at a fixed potential or fed an imposed total current. They are the Dirichlet groups of a
-:class:`~yade_electro.condensation.ReducedSystem`; the unknowns are the other nodes.
+:class:`~yade_electro.network.condensation.ReducedSystem`; the unknowns are the other nodes.
 
 How a solve works (:class:`ConductionProblem`)
 ----------------------------------------------
@@ -48,199 +48,21 @@ from __future__ import annotations
 import logging
 import time
 import warnings
-from dataclasses import dataclass, field
-from typing import Dict, Mapping, Optional, Sequence
+from typing import Mapping, Optional, Sequence
 
 import numpy as np
 import scipy.linalg
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .condensation import ReducedSystem
-from .errors import BoundaryConditionError, MaterialError, SolverError
-from .materials import real_number
-from .solvers import make_solver
+from .kirchhoff import Electrode, electrode_value, network_components
+from .records import PotentialSolution
+from ..core.errors import BoundaryConditionError, MaterialError, SolverError
+from ..core.graph import edge_slots
+from ..solvers.registry import make_solver
 
-__all__ = ["Electrode", "PotentialSolution", "ConductionProblem", "laplacian", "solve_potential", "edge_power",
-           "equivalent_resistance", "network_components", "electrode_value", "edge_slots"]
+__all__ = ["ConductionProblem", "solve_potential", "equivalent_resistance"]
 
 log = logging.getLogger(__name__)
-
-
-def laplacian(edges, conductance, n_nodes: int) -> sp.csr_matrix:
-    """K = A^T C A of a network [S]: symmetric, rows summing to zero.
-
-    Parameters
-    ----------
-    edges : (m, 2) int array of node indices
-    conductance : (m,) array of edge conductances [S], >= 0
-    n_nodes : number of nodes
-    """
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    c = np.asarray(conductance, dtype=float)
-    if c.shape != (edges.shape[0],):
-        raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {c.shape}")
-    i, j = edges[:, 0], edges[:, 1]
-    diag = np.bincount(i, c, n_nodes) + np.bincount(j, c, n_nodes)
-    rows = np.concatenate([i, j, np.arange(n_nodes)])
-    cols = np.concatenate([j, i, np.arange(n_nodes)])
-    vals = np.concatenate([-c, -c, diag])
-    return sp.csr_matrix((vals, (rows, cols)), shape=(n_nodes, n_nodes))
-
-
-def network_components(n_nodes: int, edges, conducting=None) -> tuple:
-    """(count, label per node) of the connected parts of a network, through the edges where
-    ``conducting`` (default: all) is true."""
-    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    if conducting is not None:
-        edges = edges[np.asarray(conducting, bool)]
-    adj = sp.coo_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n_nodes, n_nodes))
-    return connected_components(adj, directed=False)
-
-
-def edge_slots(candidates, edges, n_nodes: int):
-    """Positions of the node pairs ``edges`` among ``candidates`` (both (m, 2), any order within a
-    pair), or None when some pair is not a candidate."""
-    c = np.sort(np.asarray(candidates, dtype=np.int64).reshape(-1, 2), axis=1)
-    e = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
-    if e.shape[0] == 0:
-        return np.zeros(0, dtype=np.int64)
-    if c.shape[0] == 0:
-        return None
-    kc = c[:, 0] * n_nodes + c[:, 1]
-    ke = e[:, 0] * n_nodes + e[:, 1]
-    order = np.argsort(kc)
-    pos = np.clip(np.searchsorted(kc[order], ke), 0, kc.size - 1)
-    if not np.all(kc[order][pos] == ke):
-        return None
-    return order[pos]
-
-
-def electrode_value(name: str, value) -> float:
-    """An electrode potential [V] or current [A] as a finite float, or BoundaryConditionError."""
-    try:
-        return real_number(f"electrode {name!r}: value", value, what="a real number (V or A)")
-    except MaterialError as exc:
-        raise BoundaryConditionError(str(exc)) from None
-
-
-def edge_power(branch_current, conductance) -> np.ndarray:
-    """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
-    carry no current)."""
-    c = np.asarray(conductance, dtype=float)
-    w = np.asarray(branch_current, dtype=float)
-    return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
-
-
-@dataclass(frozen=True)
-class Electrode:
-    """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current.
-
-    Parameters
-    ----------
-    name : str
-    nodes : int array
-        Node indices (not body ids; see ``ContactGraph.index_of``).
-    potential : float, optional
-        Fixed potential [V].
-    current : float, optional
-        Imposed total current [A] fed into the network (its potential is then an unknown).
-        Give exactly one of ``potential`` and ``current``.
-    """
-
-    name: str
-    nodes: np.ndarray
-    potential: Optional[float] = None
-    current: Optional[float] = None
-
-    def __post_init__(self):
-        raw = np.asarray(self.nodes).reshape(-1)
-        if raw.size and not (np.issubdtype(raw.dtype, np.integer)):
-            raise BoundaryConditionError(f"electrode {self.name!r}: nodes must be integer indices, got "
-                                         f"{raw[:5].tolist()}")
-        nodes = np.unique(raw.astype(np.int64))
-        if nodes.size == 0:
-            raise BoundaryConditionError(f"electrode {self.name!r} selects no element: check its "
-                                         "predicate/box, ids or mask against the packing")
-        if (self.potential is None) == (self.current is None):
-            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
-                                         "(fixed potential, V) or current= (imposed current, A)")
-        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
-        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
-        nodes.setflags(write=False)
-        object.__setattr__(self, "nodes", nodes)
-
-    @property
-    def fixed(self) -> bool:
-        return self.potential is not None
-
-    @property
-    def value(self) -> float:
-        return float(self.potential if self.fixed else self.current)
-
-
-@dataclass(frozen=True, eq=False)
-class PotentialSolution:
-    """Result of one potential solve (SI units: V, A, ohm).
-
-    Attributes
-    ----------
-    potential : (n,) node potentials [V] (0 on floating clusters)
-    branch_current : (m,) current from ``edges[k,0]`` to ``edges[k,1]`` [A]
-    electrode_potential, electrode_current : dict name -> V, A (current fed into the network)
-    floating : (n,) bool, nodes in parts with no potential reference (no current, potential 0)
-    residual : largest relative residual of the linear solves behind this solution
-    current_imbalance : |sum of electrode currents + injections| / max |electrode current|
-    component_of_electrode : dict name -> connected part label
-    conductance_matrix : (ne, ne) S [S], electrode currents I = S V (+ injection part)
-    info : solver information (name, iterations, times)
-    """
-
-    potential: np.ndarray
-    branch_current: np.ndarray
-    electrode_potential: Dict[str, float]
-    electrode_current: Dict[str, float]
-    floating: np.ndarray
-    residual: float
-    current_imbalance: float
-    component_of_electrode: Dict[str, int]
-    conductance_matrix: np.ndarray = None
-    info: dict = field(default_factory=dict)
-
-    def equivalent_resistance(self, a: str, b: str) -> float:
-        """R_eq [ohm] between electrodes a and b, the other electrodes left open (floating):
-        a property of the network, exact for any applied values; inf when a and b are not
-        connected."""
-        names = list(self.electrode_current)
-        for e in (a, b):
-            if e not in self.electrode_current:
-                raise BoundaryConditionError(f"no electrode named {e!r}; have {sorted(names)}")
-        if a == b:
-            raise BoundaryConditionError(f"R_eq needs two different electrodes, got {a!r} twice")
-        comp = self.component_of_electrode
-        if comp[a] != comp[b]:
-            return float("inf")
-        return _two_terminal_resistance(self.conductance_matrix, names, comp, a, b)
-
-    def joule_power(self, conductance) -> np.ndarray:
-        """Power dissipated in each edge, w^2 / c [W] (see :func:`edge_power`)."""
-        return edge_power(self.branch_current, conductance)
-
-
-def _two_terminal_resistance(S, names, comp, a, b) -> float:
-    idx = [k for k, nm in enumerate(names) if comp[nm] == comp[a]]
-    ia, ib = names.index(a), names.index(b)
-    others = [k for k in idx if k not in (ia, ib)]
-    Saa = S[np.ix_([ia, ib], [ia, ib])]
-    if others:
-        Sao = S[np.ix_([ia, ib], others)]
-        Soo = S[np.ix_(others, others)]
-        Saa = Saa - Sao @ np.linalg.solve(Soo, Sao.T)
-    g = -Saa[0, 1]
-    scale = float(np.max(np.abs(S))) if S.size else 0.0
-    if not g > 1e-14 * scale:
-        return float("inf")
-    return float(1.0 / g)
 
 
 def _ro(a):
@@ -269,7 +91,7 @@ class ConductionProblem:
     conductance : (m,) array [S], >= 0
     electrodes : sequence of Electrode
     injection : (n,) currents injected into nodes [A], optional
-    solver : name or solver object (see :mod:`yade_electro.solvers`); 'auto' by size
+    solver : name or solver object (see :mod:`yade_electro.solvers.registry`); 'auto' by size
     coords : (n, 3) node positions [m], optional (for the coarse space of 'cg-deflated')
     """
 

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .errors import ElectroError
+from ..core.errors import ElectroError
 
 __all__ = ["ProbeError", "ProbeValues", "probe", "line_probe", "plane_probe", "section_mean", "region_mean",
            "slab_means", "element_gradients"]

@@ -1,0 +1,18 @@
+"""The transport core, physics-blind: condensation of fixed values, Kirchhoff networks with
+electrodes, the heat network's boundary conditions, the theta-method integrator with sub-cycling,
+steady solves and the energy ledger. Never imports YADE.
+"""
+from .condensation import ReducedSystem
+from .conditions import (FixedTemperature, ThermalWall, HeatFlux, Convection, HeatSource, resolve_nodes,
+                         resolve_area, ResolvedConditions, resolve_conditions)
+from .conduction import ConductionProblem, solve_potential, equivalent_resistance
+from .kirchhoff import laplacian, network_components, electrode_value, edge_power, Electrode
+from .records import PotentialSolution, ThermalState, HeatStep, SteadyHeat, read_only_copy
+from .theta import theta_of, stable_time_step, THETA_NAMES
+from .transient import HeatSolver
+
+__all__ = ["ReducedSystem", "FixedTemperature", "ThermalWall", "HeatFlux", "Convection", "HeatSource",
+           "resolve_nodes", "resolve_area", "ResolvedConditions", "resolve_conditions", "ConductionProblem",
+           "solve_potential", "equivalent_resistance", "laplacian", "network_components", "electrode_value",
+           "edge_power", "Electrode", "PotentialSolution", "ThermalState", "HeatStep", "SteadyHeat",
+           "read_only_copy", "theta_of", "stable_time_step", "THETA_NAMES", "HeatSolver"]

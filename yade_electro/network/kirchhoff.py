@@ -1,0 +1,111 @@
+"""The vocabulary of Kirchhoff networks: the Laplacian, connected parts, electrodes, edge power.
+
+See :mod:`yade_electro.network.conduction` for the sign conventions. Units: SI (S, V, A, W).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ..core.errors import BoundaryConditionError, MaterialError
+from ..core.materials import real_number
+
+__all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "Electrode"]
+
+
+def laplacian(edges, conductance, n_nodes: int) -> sp.csr_matrix:
+    """K = A^T C A of a network [S]: symmetric, rows summing to zero.
+
+    Parameters
+    ----------
+    edges : (m, 2) int array of node indices
+    conductance : (m,) array of edge conductances [S], >= 0
+    n_nodes : number of nodes
+    """
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    c = np.asarray(conductance, dtype=float)
+    if c.shape != (edges.shape[0],):
+        raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {c.shape}")
+    i, j = edges[:, 0], edges[:, 1]
+    diag = np.bincount(i, c, n_nodes) + np.bincount(j, c, n_nodes)
+    rows = np.concatenate([i, j, np.arange(n_nodes)])
+    cols = np.concatenate([j, i, np.arange(n_nodes)])
+    vals = np.concatenate([-c, -c, diag])
+    return sp.csr_matrix((vals, (rows, cols)), shape=(n_nodes, n_nodes))
+
+
+def network_components(n_nodes: int, edges, conducting=None) -> tuple:
+    """(count, label per node) of the connected parts of a network, through the edges where
+    ``conducting`` (default: all) is true."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if conducting is not None:
+        edges = edges[np.asarray(conducting, bool)]
+    adj = sp.coo_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n_nodes, n_nodes))
+    return connected_components(adj, directed=False)
+
+
+def electrode_value(name: str, value) -> float:
+    """An electrode potential [V] or current [A] as a finite float, or BoundaryConditionError."""
+    try:
+        return real_number(f"electrode {name!r}: value", value, what="a real number (V or A)")
+    except MaterialError as exc:
+        raise BoundaryConditionError(str(exc)) from None
+
+
+def edge_power(branch_current, conductance) -> np.ndarray:
+    """Power dissipated in each edge, w^2 / c [W]; 0 on edges of zero conductance (they
+    carry no current)."""
+    c = np.asarray(conductance, dtype=float)
+    w = np.asarray(branch_current, dtype=float)
+    return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
+
+
+@dataclass(frozen=True)
+class Electrode:
+    """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current.
+
+    Parameters
+    ----------
+    name : str
+    nodes : int array
+        Node indices (not body ids; see ``ContactGraph.index_of``).
+    potential : float, optional
+        Fixed potential [V].
+    current : float, optional
+        Imposed total current [A] fed into the network (its potential is then an unknown).
+        Give exactly one of ``potential`` and ``current``.
+    """
+
+    name: str
+    nodes: np.ndarray
+    potential: Optional[float] = None
+    current: Optional[float] = None
+
+    def __post_init__(self):
+        raw = np.asarray(self.nodes).reshape(-1)
+        if raw.size and not (np.issubdtype(raw.dtype, np.integer)):
+            raise BoundaryConditionError(f"electrode {self.name!r}: nodes must be integer indices, got "
+                                         f"{raw[:5].tolist()}")
+        nodes = np.unique(raw.astype(np.int64))
+        if nodes.size == 0:
+            raise BoundaryConditionError(f"electrode {self.name!r} selects no element: check its "
+                                         "predicate/box, ids or mask against the packing")
+        if (self.potential is None) == (self.current is None):
+            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
+                                         "(fixed potential, V) or current= (imposed current, A)")
+        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
+        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
+        nodes.setflags(write=False)
+        object.__setattr__(self, "nodes", nodes)
+
+    @property
+    def fixed(self) -> bool:
+        return self.potential is not None
+
+    @property
+    def value(self) -> float:
+        return float(self.potential if self.fixed else self.current)

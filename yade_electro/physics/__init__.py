@@ -1,0 +1,11 @@
+"""Physics layers on the transport core: electrical (c = g / rho_e(T)), thermal (G = lambda g,
+capacities, Joule sources) and the coupled electro-thermal model (the one owner of time and energy).
+"""
+from .coupled import ElectroThermalModel
+from .electrical import ElectrodeSpec, ElectricalModel, electrode_specs
+from .thermal import (heat_capacity, thermal_conductance, diffusion_time_step, edge_joule_power,
+                      joule_sources, electrical_power, heat_solver_on_graph)
+
+__all__ = ["ElectroThermalModel", "ElectrodeSpec", "ElectricalModel", "electrode_specs", "heat_capacity",
+           "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
+           "electrical_power", "heat_solver_on_graph"]

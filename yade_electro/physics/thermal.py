@@ -1,0 +1,174 @@
+"""The thermal physics layer: heat capacities, thermal conductances and Joule sources.
+
+The lumped heat balance of a packing (paper 000 eq. 13 and 16, paper 003 eq. 14):
+
+    C_i dT_i/dt = P_i + sum_j G_ij (T_j - T_i) + h_i A_i (T_inf,i - T_i) + Q_i
+
+* ``C_i = rho c V_i / fv_i`` [J/K], the heat capacity of the volume the element stands for
+  (:func:`heat_capacity`);
+* ``P_i`` [W], half the Joule power ``eta w_ij^2 / c_ij`` of every bond of i
+  (:func:`joule_sources`);
+* ``G_ij = lambda S_ij / l_ij`` [W/K], the thermal conductance; any electrical conductance
+  law gives it when called with the thermal resistivity 1/lambda
+  (:func:`thermal_conductance`; the 'continuum' law gives exactly paper 000 eq. 16);
+* convection ``h A (T_inf - T)`` on free-surface elements and imposed heat inputs ``Q_i``
+  [W]; fixed-temperature node sets take the place of electrodes.
+
+In matrix form ``C dT/dt = -M T + s`` with ``M = K + diag(h A)`` (K the Laplacian of G) and
+``s = P + Q + h A T_inf``. :class:`HeatSolver` integrates it with the theta family (paper
+003): ``(C/dt + theta M) T^{n+1} = (C/dt - (1 - theta) M) T^n + s``, sources constant over
+the step; ``theta = 0`` is forward Euler (no solve), ``1/2`` Crank-Nicolson, ``1`` backward
+Euler. Fixed-temperature nodes are eliminated from the unknowns.
+
+Stability of the explicit scheme
+--------------------------------
+Forward Euler keeps every new temperature a convex combination of the old ones (so no
+oscillation and no growth) when ``dt <= dt_crit = min_i C_i / M_ii`` over the free nodes
+(:func:`stable_time_step`, the diagonal/Gershgorin bound; for two equal elements it is
+exactly the stability limit C/G). For ``theta < 1/2`` the bound is ``dt_crit / (1 - 2
+theta)``. A requested step above ``safety * bound`` is split into ``n_sub = ceil(dt /
+(safety * bound))`` equal sub-steps, or raises :class:`ThermalError` when sub-cycling is
+off. Paper 000 eq. 14 quotes ``l_min^2 / (2 alpha)``, alpha = lambda / (rho c)
+(:func:`diffusion_time_step`); it ignores the volume fractions, the surfaces and the
+number of neighbours (it is the 1D bound), so it is reported for comparison only: on a simple
+cubic lattice the lumped bound is about 4x smaller (interior elements C/sum G = (2/3) r^2 /
+alpha against the paper's 2 r^2 / alpha; edge and corner elements lower still), so a step
+taken from eq. 14 alone would be unstable. ``theta >= 1/2`` has no step limit; only ``theta = 1`` keeps
+the maximum principle at any step (Crank-Nicolson oscillates for steps far above dt_crit).
+
+Units: SI (kg/m^3, J/(kg K), W/(m K), W/(m^2 K), K or degC, J/K, W, s).
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from ..core.graph import ContactGraph
+from ..core.materials import edge_conductivity, positive_property
+from ..laws.conductance import make_law
+from ..laws.transmission import volume_fraction as _volume_fraction
+from ..network.kirchhoff import edge_power
+from ..network.transient import HeatSolver
+
+__all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
+           "electrical_power", "heat_solver_on_graph"]
+
+
+# ---------------------------------------------------------------------------------------
+# material input
+# ---------------------------------------------------------------------------------------
+def heat_capacity(graph: ContactGraph, density, specific_heat, volume_fraction=None, cell_volume=None,
+                  threshold: float = 0.4, factor: float = 2.0) -> np.ndarray:
+    """Heat capacity C_i of every element [J/K].
+
+    ``C_i = rho c V_i / fv_i`` (paper 000 eq. 13), V_i the sphere volume and fv_i the volume
+    fraction of the continuum model (:func:`yade_electro.laws.transmission.volume_fraction`), so that
+    the element carries the heat capacity of the polyhedron it stands for.
+
+    Parameters
+    ----------
+    graph : ContactGraph
+    density : float or (n,) [kg/m^3], > 0
+    specific_heat : float or (n,) [J/(kg K)], > 0
+    volume_fraction : float or (n,), optional
+        Explicit fv_i (e.g. 1.0 for the paper's rod check); default from the bond graph.
+    cell_volume : (n,) array [m^3], optional
+        Volumes of the cells the elements stand for (e.g. Voronoi cells); then
+        ``C_i = rho c V_cell_i`` and ``volume_fraction`` must not be given.
+    threshold, factor : eccentricity rule of the default volume fraction.
+
+    Raises
+    ------
+    MaterialError
+        A non-positive or non-finite density, specific heat, volume fraction or cell volume.
+    """
+    n = graph.n_nodes
+    rc = positive_property("density", density, n, " (kg/m^3)") * positive_property("specific_heat", specific_heat, n,
+                                                                      " (J/(kg K))")
+    if cell_volume is not None:
+        if volume_fraction is not None:
+            raise ValueError("give volume_fraction= or cell_volume=, not both")
+        v = positive_property("cell_volume", cell_volume, n, " (m^3)")
+        return np.broadcast_to(rc * v, (n,)).astype(float)
+    if volume_fraction is None:
+        fv = _volume_fraction(graph, threshold=threshold, factor=factor)
+    else:
+        fv = positive_property("volume_fraction", volume_fraction, n)
+    return np.broadcast_to(rc * graph.volume / fv, (n,)).astype(float)
+
+
+def thermal_conductance(graph: ContactGraph, conductivity, law="continuum", **params) -> np.ndarray:
+    """Thermal conductance G_ij of every edge of ``graph`` [W/K]: ``lambda_edge g`` with the
+    law's geometric factor g (for 'continuum', ``lambda S_ij / l_ij``, paper 000 eq. 16);
+    per-node conductivities make an edge two half rods in series (harmonic mean).
+
+    Raises
+    ------
+    MaterialError
+        A non-positive or non-finite conductivity [W/(m K)].
+    """
+    lam = positive_property("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
+    return edge_conductivity(lam, graph.edges) * make_law(law, **params).factor(graph, graph.edges)
+
+
+def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_heat) -> float:
+    """Paper 000 eq. 14: ``l_min^2 / (2 alpha)`` [s], alpha = lambda / (rho c) (the largest
+    over the nodes when properties vary). For comparison with :func:`stable_time_step`,
+    which is the bound the integrators use."""
+    n = graph.n_nodes
+    alpha = (positive_property("thermal conductivity", conductivity, n) /
+             (positive_property("density", density, n) * positive_property("specific_heat", specific_heat, n)))
+    if graph.n_edges == 0:
+        return math.inf
+    return float(np.min(graph.length) ** 2 / (2.0 * np.max(alpha)))
+
+
+# ---------------------------------------------------------------------------------------
+# Joule heating
+# ---------------------------------------------------------------------------------------
+def edge_joule_power(branch_current, conductance, eta: float = 1.0) -> np.ndarray:
+    """Heat released in every edge, ``eta u_ij w_ij = eta w_ij^2 / c_ij`` [W] (paper 000
+    eq. 11); 0 on edges of zero conductance (they carry no current)."""
+    if not (0.0 <= eta <= 1.0):
+        raise ValueError(f"eta (share of the electrical power released as heat) must be in [0, 1], got {eta}")
+    w = np.asarray(branch_current, dtype=float)
+    c = np.asarray(conductance, dtype=float)
+    if w.shape != c.shape or w.ndim != 1:
+        raise ValueError(f"branch_current and conductance must be (m,) arrays of one shape, got {w.shape} "
+                         f"and {c.shape}")
+    return eta * edge_power(w, c)
+
+
+def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float = 1.0) -> np.ndarray:
+    """Joule power received by every node [W]: each edge's ``eta w^2 / c`` shared half and half
+    by its two end nodes. The total equals ``eta * sum_e V_e I_e`` over the electrodes
+    (:func:`electrical_power`) when no current is injected elsewhere."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    p = edge_joule_power(branch_current, conductance, eta)
+    if p.shape[0] != edges.shape[0]:
+        raise ValueError(f"one branch current per edge expected ({edges.shape[0]}), got {p.shape[0]}")
+    return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
+
+
+def electrical_power(solution) -> float:
+    """``sum_e V_e I_e`` over the electrodes of a PotentialSolution [W]: the power the external
+    circuit delivers (Tellegen: equals the total Joule power of the network)."""
+    return float(sum(solution.electrode_potential[k] * solution.electrode_current[k]
+                     for k in solution.electrode_current))
+
+
+# ---------------------------------------------------------------------------------------
+# a heat solver on a graph
+# ---------------------------------------------------------------------------------------
+def heat_solver_on_graph(graph: ContactGraph, density, specific_heat, conductivity, temperature, *,
+                         law="continuum", law_params: Optional[dict] = None, volume_fraction=None,
+                         cell_volume=None, **kw) -> HeatSolver:
+    """A :class:`~yade_electro.network.transient.HeatSolver` on ``graph``: capacities by
+    :func:`heat_capacity`, conductances by :func:`thermal_conductance` with ``law``; other
+    keywords go to the solver's constructor (boundary conditions may then use selectors)."""
+    C = heat_capacity(graph, density, specific_heat, volume_fraction=volume_fraction, cell_volume=cell_volume)
+    G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
+    kw.setdefault("coords", graph.pos)
+    return HeatSolver(C, graph.edges, G, temperature, graph=graph, **kw)
