@@ -320,7 +320,7 @@ def test_plot_history_from_csv_and_history(tmp_path):
 
 
 def test_overlap_warns_when_yade_leaves_no_core_free():
-    from yade_electro.yade.engines import overlap_competes
+    from yade_electro.yade.overlap import overlap_competes
     assert overlap_competes(1, 2) is None and overlap_competes(3, 8) is None
     said = overlap_competes(2, 2)
     assert said.startswith("overlap=True: YADE runs 2 thread(s) on 2 core(s)") and "yade -j 1" in said

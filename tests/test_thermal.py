@@ -29,7 +29,8 @@ from yade_electro.network.conditions import Convection, FixedTemperature, HeatFl
 from yade_electro.network.transient import HeatSolver
 from yade_electro.laws.transmission import exposed_area
 from yade_electro.network.theta import theta_of
-from yade_electro.physics.thermal import diffusion_time_step, edge_joule_power, electrical_power, heat_capacity, joule_sources, thermal_conductance
+from yade_electro.physics.thermal import (diffusion_time_step, edge_joule_power, electrical_power, heat_capacity,
+                                          heat_solver_on_graph, joule_sources, thermal_conductance)
 from yade_electro.network.theta import stable_time_step
 
 from lattice import cubic_lattice, end_selectors, node_class
@@ -358,7 +359,7 @@ def test_convection_rate_is_hA_over_C():
 
 def test_default_exposed_area_with_graph():
     g = rod()
-    hs = HeatSolver.from_graph(g, DENSITY, SPECIFIC_HEAT, LAMBDA, 400.0,
+    hs = heat_solver_on_graph(g, DENSITY, SPECIFIC_HEAT, LAMBDA, 400.0,
                                convection=[Convection("air", np.ones(g.n_nodes, bool), h=10.0, t_inf=300.0)])
     np.testing.assert_allclose(hs.h_area, 10.0 * exposed_area(g))
     with pytest.raises(BoundaryConditionError, match="area"):
@@ -467,7 +468,7 @@ def test_bad_capacity_and_conductance_raise_material_error():
     with pytest.raises(MaterialError):
         Convection("air", [0], h=-1.0, t_inf=300.0)
     with pytest.raises(MaterialError):
-        HeatSolver.from_graph(rod(), DENSITY, SPECIFIC_HEAT, 0.0, 300.0)
+        heat_solver_on_graph(rod(), DENSITY, SPECIFIC_HEAT, 0.0, 300.0)
 
 
 @pytest.mark.parametrize("dt", [0.0, -1.0, np.nan, np.inf])

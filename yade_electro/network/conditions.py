@@ -67,7 +67,7 @@ class FixedTemperature:
     """A fixed temperature [K or degC, as the model] on a node set or at a surface.
 
     ``nodes``: node indices (HeatSolver), or, when a graph is given
-    (``HeatSolver.from_graph``, ``ElectroThermalModel``), anything
+    (:func:`~yade_electro.physics.thermal.heat_solver_on_graph`, ``ElectroThermalModel``), anything
     ``yade_electro.core.selection.select_nodes`` takes (callable, mask, graph ids): those
     elements are held at ``temperature``. ``surface``: a surface of the container
     (``shape.face('top')``, see :mod:`yade_electro.geometry.surface_contact`; needs ``ElectroThermalModel``):
@@ -207,7 +207,7 @@ def resolve_nodes(bc, n: int, graph: Optional[ContactGraph]) -> np.ndarray:
         return select_nodes(graph, bc.nodes, bc.name, "thermal boundary condition")
     if callable(bc.nodes):
         raise BoundaryConditionError(f"thermal boundary condition {bc.name!r}: a selector needs a graph; give "
-                                     "node indices or use HeatSolver.from_graph")
+                                     "node indices or use heat_solver_on_graph")
     a = np.asarray(bc.nodes)
     if a.dtype == bool:
         if a.shape != (n,):

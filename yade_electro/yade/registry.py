@@ -30,12 +30,31 @@ from typing import Dict, Optional
 
 from . import persistence
 
-__all__ = ["ENGINES", "get_engine", "run", "attach", "claim_label", "check_shared_outputs", "live_engines"]
+__all__ = ["ENGINES", "get_engine", "run", "attach", "claim_label", "check_shared_outputs", "live_engines",
+           "engine_type", "engine_class"]
 
 log = logging.getLogger(__name__)
 
 #: Engines by label, so that the PyRunner command (a string YADE evaluates) can reach them.
 ENGINES: Dict[str, object] = {}
+
+#: Engine classes by name, for re-attaching a saved configuration (filled by :func:`engine_type`).
+_ENGINE_TYPES: Dict[str, type] = {}
+
+
+def engine_type(cls: type) -> type:
+    """Class decorator: register an engine class under its name, so that a scene saved with it
+    re-attaches it after ``O.load``."""
+    _ENGINE_TYPES[cls.__name__] = cls
+    return cls
+
+
+def engine_class(name: str) -> type:
+    """The engine class of a saved configuration."""
+    try:
+        return _ENGINE_TYPES[name]
+    except KeyError:
+        raise KeyError(f"unknown saved engine type {name!r}; known: {sorted(_ENGINE_TYPES)}") from None
 
 
 def live_engines(O=None) -> dict:
@@ -97,7 +116,6 @@ def attach(label: Optional[str] = None, O=None, **overrides):
     None) and return it; it continues exactly where the saved run was (values, thermal clock,
     energies, temperatures from ``b.state.temp``, history appended). ``overrides`` replace
     saved constructor arguments (e.g. selectors that could not be saved)."""
-    from .engines import engine_class
     from .runtime import import_yade
     O = O if O is not None else import_yade().Omega()
     labels = persistence.saved_labels(O)
@@ -123,7 +141,7 @@ def run(label: str):
     """The PyRunner entry point: one step of the engine ``label`` (re-attached if needed)."""
     engine = ENGINES.get(label)
     if engine is None or engine.removed:
-        from .engines import MPY_REFUSAL, in_mpy_subdomain
+        from .runtime import MPY_REFUSAL, in_mpy_subdomain
         if in_mpy_subdomain():             # before a re-attach reads a subdomain's bodies
             raise RuntimeError(MPY_REFUSAL.format(label=label))
         from .runtime import import_yade

@@ -13,7 +13,7 @@ import os
 import sys
 import warnings
 
-__all__ = ["import_yade", "in_yade", "yade_python_dirs"]
+__all__ = ["import_yade", "in_yade", "yade_python_dirs", "MPY_REFUSAL", "in_mpy_subdomain"]
 
 #: Directories tried first, in order; the double-precision build is the default ``yade``.
 PREFERRED_DIRS = (
@@ -85,3 +85,19 @@ def import_yade():
         errors.append("no directory /usr/lib/*/yade*/py holds a `yade` package")
     raise ImportError("%s\nTried with %s:\n  %s"
                       % (INSTALL_HINT, sys.executable, "\n  ".join(errors)))
+
+
+MPY_REFUSAL = ("engine {label!r}: this scene is a subdomain of yade.mpy's decomposition (O.subD is set): the "
+               "engine would see only this rank's bodies and give wrong results. Run the whole scene on every "
+               "rank (mpiexec without mpy.mpirun) with solver='petsc' to share the solve, or call the engine on "
+               "the master's merged scene after mpy.mpirun(..., withMerge=True)")
+
+
+def in_mpy_subdomain() -> bool:
+    """True when yade.mpy has split the scene into subdomains (it sets ``O.subD`` on its own
+    Omega handle when ``mpirun`` starts; plain ``mpiexec`` runs without mpirun do not)."""
+    mpy = sys.modules.get("yade.mpy")
+    return mpy is not None and getattr(getattr(mpy, "O", None), "subD", None) is not None
+
+
+# =========================================================================================

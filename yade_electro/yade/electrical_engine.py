@@ -1,0 +1,300 @@
+"""The engines for ``O.engines``: ``PyRunner``s that read the graph (only what changed), bring
+the kept model up to date, write results back to the bodies and append a history row.
+
+Example (in a YADE script)::
+
+    from yade import pack
+    from yade_electro.yade import ElectricalEngine
+    electro = ElectricalEngine(
+        resistivity=0.73e-6,
+        electrodes={"top": dict(select=pack.inAlignedBox((-1, -1, 4.9e-3), (1, 1, 1)), potential=1.0),
+                    "bottom": dict(select=pack.inAlignedBox((-1, -1, -1), (1, 1, 0.1e-3)), potential=0.0)},
+        iterPeriod=100, history="electro.csv")
+    O.engines = O.engines + [electro.runner]
+    O.run(1000, True)
+    print(electro.equivalent_resistance, electro.potential_by_id[0])
+
+Electrode selectors: YADE predicates (selection by element centre), lists of body ids,
+boolean masks, or callables ``f(pos, radius) -> mask``; ``dict(mask=m)`` selects the bodies
+with ``b.mask & m``. The elements are selected once, when the engine is built, and kept by
+body id (``reselect=True`` selects again on each new structure).
+
+Everything is checked when the engine is built, in the user's script, with the real
+exception type (YADE reports errors inside ``O.run`` only as ``PyRunner error``).
+
+Save and load: the engine keeps its configuration and state in ``O.tags``
+(:mod:`.persistence`); after ``O.load`` it continues by itself (the saved PyRunner re-attaches
+it), and ``engine = yade_electro.yade.attach(label)`` gives back a handle.
+"""
+from __future__ import annotations
+
+import logging
+from typing import Dict, Optional
+
+import numpy as np
+
+from ..physics.electrical import ElectricalModel, ElectrodeSpec
+from ..core.errors import BoundaryConditionError
+from ..geometry.shapes import Shape, as_shape
+from . import persistence
+from . import registry
+from .granular import check_wall_bodies
+from .scene import write_body_attribute
+
+from .engine_base import EngineBase, electrode_walls, material_table
+__all__ = ["ElectricalEngine"]
+
+log = logging.getLogger(__name__)
+
+
+@registry.engine_type
+class ElectricalEngine(EngineBase):
+    """Electrical conduction solved every ``iterPeriod`` steps of a YADE simulation.
+
+    Parameters
+    ----------
+    resistivity : float
+        rho_e [ohm m].
+    materials : dict YADE material -> dict(resistivity=ohm m), optional
+        Elements of several materials: the key is a material of ``O.materials`` (its label,
+        or its index); its spheres take that resistivity, the others ``resistivity``. Looked
+        up again whenever the element set changes. An edge takes the mean of its two ends'.
+    electrodes : dict name -> dict(select=... | surface=... | wall=..., potential=V | current=A)
+        ``select``: an element layer (predicate, ids, mask; paper 000's electrodes).
+        ``surface``: a surface of the container (``container.face('top')``, a ``Plane``, a
+        region): the electrode acts at that surface, through each touching element's half cell.
+        ``wall``: body id(s) of a ``Wall``, ``Box`` or facet mesh of a granular bed
+        (``bonds='contacts'``): each particle touching it conducts through its contact.
+    law : str, optional
+        Conductance law; default ``'voronoi'`` when the container is known, else
+        ``'continuum'`` (paper 000's transmission-surface model).
+    container : Shape or YADE predicate, optional
+        The solid. Default: ``law_params['container']``, else the container of the packing
+        ``add_bonded_packing`` put in the scene.
+    law_params, solver, measure, reselect : see ``yade_electro.physics.electrical.ElectricalModel``
+        (a YADE predicate as ``law_params['container']`` is converted to a shape)
+    iterPeriod : int >= 1
+        Steps between two calls (the PyRunner's period).
+    history : str, optional
+        CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
+    history_mode : {'w', 'a', 'x'}
+        Replace (saying so), append to, or refuse an existing file.
+    bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check, sweep_calls :
+        see :class:`~yade_electro.yade.scene.SceneReader` (``bonds='cohesive'``, a bonded solid)
+    skin : 'auto' or float
+        ``bonds='contacts'`` (a granular bed): the Verlet skin in smallest radii, adapted to the
+        motion by default (see :class:`~yade_electro.yade.granular.GranularReader`); positions
+        are read at every call.
+    write_back : str or None
+        Body attribute that receives each element's potential [V] (default 'potential');
+        None to skip. YADE's own attributes are refused.
+    plot : bool
+        Also feed ``yade.plot.addData`` with the history row.
+    label : str, optional
+        Label of the PyRunner and key in the registry (default 'electro', numbered if taken).
+    """
+
+    DEFAULT_LABEL = "electro"
+
+    def __init__(self, resistivity=None, electrodes=None, law=None, law_params=None, solver="auto",
+                 measure=None, iterPeriod: int = 1, history: Optional[str] = None, history_mode: str = "w",
+                 bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
+                 full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
+                 write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
+                 reselect: bool = False, container=None, skin="auto", materials=None, O=None, _resume=None):
+        reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
+                              skin=skin, walls=electrode_walls(electrodes) or None)
+        self._options_bonds = bonds
+        self._electrode_walls = electrode_walls(electrodes)
+        self._declared_walls = list(self._electrode_walls)
+        self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode, write_back, plot)
+        self._materials = material_table(self.O, materials, ("resistivity",))
+        self._materials_config = materials
+        law, law_params = self._law_and_container(law, law_params, container)
+        self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
+        self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
+        self._finish(history_mode)
+
+    def _law_and_container(self, law, law_params, container):
+        """The container (given, the law's, or the scene's packing's) and the law (default
+        'voronoi' with a container, else 'continuum')."""
+        law_params = dict(law_params or {})
+        if container is None:
+            container = law_params.get("container")
+        if container is None:
+            container = persistence.scene_container(self.O)
+        if container is not None and not isinstance(container, Shape):
+            container = as_shape(container)
+        self.container = container
+        granular = self._options_bonds == "contacts"
+        if law is None:
+            law = "contact" if granular else ("voronoi" if container is not None else "continuum")
+        from ..laws.conductance import is_contact_law as _is_contact_law
+        is_contact_law = _is_contact_law(law)
+        if granular and not is_contact_law:
+            raise ValueError(f"law {law!r} is a law of bonded solids, but bonds='contacts' (a granular bed): use "
+                             "law='contact' or 'liggghts' (conduction through the contact areas)")
+        if not granular and is_contact_law:
+            raise ValueError(f"law {law!r} conducts through contact overlaps, but bonds='cohesive' (a bonded solid "
+                             "whose bonds do not overlap): use bonds='contacts' for a granular bed, or a solid's law "
+                             "('voronoi', 'continuum')")
+        if law == "voronoi" and container is not None:
+            law_params["container"] = law_params.get("container") or container
+        if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
+            law_params["container"] = as_shape(law_params["container"])
+        return law, law_params
+
+    def _make_electrical(self, resistivity, electrodes, law, law_params, solver, measure, reselect):
+        if resistivity is None:
+            raise ValueError("give resistivity= (ohm m)")
+        if electrodes is None or not isinstance(electrodes, dict) or not electrodes:
+            raise BoundaryConditionError("give electrodes={name: dict(select=... or surface=..., potential=V | "
+                                         "current=A)}")
+        self._law_params = law_params
+        specs = []
+        for name, spec in electrodes.items():
+            if not isinstance(spec, dict):
+                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=... or surface=..., "
+                                             "potential=...|current=...)")
+            spec = dict(spec)
+            if spec.get("select") is not None:
+                spec["select"] = self._normalise_selector(spec["select"])
+            unknown = set(spec) - {"select", "surface", "potential", "current", "wall"}
+            if unknown:
+                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select=, "
+                                             "surface= or wall=, and potential= (V) or current= (A)")
+            if spec.get("wall") is not None:           # granular mode only: checked in _start
+                check_wall_bodies(self.O, name, spec["wall"])
+                spec["wall"] = True
+            specs.append(ElectrodeSpec(name, **spec))
+        self._resistivity = resistivity
+        return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
+                               reselect=reselect, container=self.container)
+
+    # -- persistence ---------------------------------------------------------------------------
+    def _electrode_config(self):
+        out = {}
+        for s in self.model.specs:
+            value = {"potential": s.potential} if s.fixed else {"current": s.current}
+            if s.wall:
+                out[s.name] = dict(wall=list(self._electrode_walls[s.name]), **value)
+            elif s.surface is not None:
+                out[s.name] = dict(surface=self.model.surfaces[s.name].saved, **value)
+            else:
+                ids = self.model.memberships[s.name].ids
+                out[s.name] = dict(select=np.asarray(ids, dtype=np.int64), **value)
+        return out
+
+    def _law_config(self):
+        params = dict(self._law_params)
+        ref = getattr(self.model.law, "reference", None)
+        if ref is not None:
+            params["reference"] = ref
+        return params
+
+    def _config_kwargs(self):
+        o = self._options
+        return dict(resistivity=self._resistivity, electrodes=self._electrode_config(), law=o["law"],
+                    law_params=self._law_config(), solver=o["solver"] if isinstance(o["solver"], str) else "auto",
+                    measure=o["measure"], iterPeriod=self.iterPeriod, history=self.history_path,
+                    bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
+                    move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
+                    bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
+                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"],
+                    materials=self._materials_config)
+
+    def _save_state(self):
+        persistence.save_state(self.O, self.label, {
+            "iter": int(self.O.iter), "time": float(self.O.time), "values": dict(self.model.values),
+            "rows": len(self.history)})
+
+    def _prepare(self, graph):
+        if self._resume is not None:
+            for k, v in (self._resume_state.get("values") or {}).items():
+                self.model.set_electrode(k, v)
+        self._feed_electrode_walls()
+        self._apply_materials()
+        self.model.update(graph)
+
+    def _material_base(self):
+        return {"resistivity": self._resistivity}
+
+    def _set_properties(self, props):
+        self.model.set_resistivity(props["resistivity"])
+
+    def _feed_electrode_walls(self):
+        if self.model is None:
+            return
+        for name in self.model.walls:
+            self.model.set_wall_contacts(name, *self.reader.wall_contacts(name))
+
+    # -- stepping ------------------------------------------------------------------------
+    def set_electrode(self, name: str, value: float):
+        """Change an electrode's potential [V] or current [A] from the next call on."""
+        self.model.set_electrode(name, value)
+
+    def _step(self):
+        graph = self.reader.read()
+        self._feed_electrode_walls()
+        self._apply_materials()
+        sol = self.model.solve(graph)
+        if self.write_back and sol is not self._written:
+            write_body_attribute(self.reader.bodies, self.write_back, sol.potential)
+            self._written = sol
+        row = {"iter": int(self.O.iter), "time": float(self.O.time)}
+        row.update(self.model.summary())
+        row["graph_revision"] = int(graph.revision)
+        self._write_row(row)
+        return sol
+
+    # -- results -------------------------------------------------------------------------
+    @property
+    def graph(self):
+        """The network the current flows in (the bond graph, or wider for the 'voronoi' law)."""
+        return self.model.graph
+
+    @property
+    def bond_graph(self):
+        """The bonded contact graph read from the scene."""
+        return self.model.bond_graph
+
+    @property
+    def solution(self):
+        """The last PotentialSolution of the network: its nodes are the elements (in
+        ``body_ids`` order), then one node per surface electrode (use :attr:`potential`
+        for the elements' values)."""
+        return self.model.solution
+
+    @property
+    def equivalent_resistance(self) -> float:
+        """R_eq [ohm] between the ``measure`` electrodes at the last solve (network property)."""
+        return self.model.equivalent_resistance
+
+    @property
+    def body_ids(self) -> np.ndarray:
+        return self.model.bond_graph.ids
+
+    @property
+    def potential(self) -> np.ndarray:
+        """Potential [V] of each element, in ``body_ids`` order."""
+        return self.solution.potential[:self.model.n_elements]
+
+    @property
+    def potential_by_id(self) -> Dict[int, float]:
+        return dict(zip(self.body_ids.tolist(), self.potential.tolist()))
+
+    @property
+    def branch_currents(self):
+        """(id pairs (m, 2), current (m,) [A] flowing from the first body to the second), over
+        the edges that conduct."""
+        m = self.model.network_edges.shape[0]
+        keep = self.model.conductance[:m] > 0
+        return self.body_ids[self.model.network_edges[keep]], self.solution.branch_current[:m][keep]
+
+    @property
+    def electrode_currents(self) -> Dict[str, float]:
+        return dict(self.solution.electrode_current)
+
+
+# =========================================================================================

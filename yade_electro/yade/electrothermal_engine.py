@@ -1,0 +1,586 @@
+"""The electro-thermal engine: Joule heating and heat conduction every ``iterPeriod`` steps of a
+YADE simulation (see :class:`ElectroThermalEngine`)."""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import warnings
+from concurrent.futures import ThreadPoolExecutor
+from typing import Dict, Optional
+
+import numpy as np
+
+from ..physics.coupled import ElectroThermalModel
+from ..core.errors import BoundaryConditionError, ThermalError
+from ..core.materials import real_number
+from ..network.conditions import Convection, FixedTemperature, HeatFlux
+from ..network.conditions import HeatSource, ThermalWall
+from . import persistence
+from . import registry
+from .runtime import import_yade
+from .granular import check_wall_bodies
+from .scene import TemperatureWriter, write_body_attribute
+
+from .electrical_engine import ElectricalEngine
+from .engine_base import electrode_walls, material_table, synced_property
+from .overlap import WORKER, OverlapWork, available_cores, overlap_competes
+__all__ = ["ElectroThermalEngine"]
+
+log = logging.getLogger(__name__)
+
+
+@registry.engine_type
+class ElectroThermalEngine(ElectricalEngine):
+    """Joule heating and heat conduction every ``iterPeriod`` steps of a YADE simulation.
+
+    Each call reads the graph (only what changed), brings the potential up to date (a solve
+    only when the geometry, rho_e(T) or the structure changed), computes the Joule heat,
+    advances the temperatures by the thermal step and writes them to ``b.state.temp`` (a
+    ``ThermalState`` is given to bodies that do not have one) and the potential to
+    ``b.potential``. One history row per call goes to the CSV as the run goes.
+
+    Thermal time: by default each call advances by the simulated time elapsed since the
+    previous call (``O.time`` difference) times ``time_scale``; give ``thermal_dt`` to advance
+    by a fixed thermal step per call instead (the heat and mechanics then run on separate
+    clocks). Either way the integrator sub-cycles (explicit) or takes the step in one implicit
+    solve (theta method), so it is never bound to ``O.dt``.
+
+    Parameters
+    ----------
+    resistivity, electrodes, law, law_params, solver, measure, iterPeriod, history, bonds,
+    mask, geometry_every, move_tolerance, full_read_every, bond_check, plot, label : see ElectricalEngine
+        ``electrodes=None``: heat conduction only (no resistivity needed).
+    density [kg/m^3], specific_heat [J/(kg K)], conductivity [W/(m K)] : thermal material
+    temperature : initial temperature [K] (of every element, and of elements added later)
+    initial_temperature : dict body id -> K, optional
+        Starting temperatures of chosen elements (the others start at ``temperature``), e.g. a
+        hot and a cold half of a bed. Ignored when the engine resumes a saved run (the
+        temperatures are then the bodies' ``b.state.temp``).
+    beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
+    theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
+    fixed, flux, convection : lists of ``yade_electro.network.transient`` FixedTemperature, HeatFlux,
+        Convection; their ``nodes`` may be YADE predicates, body id lists or masks, or give
+        ``surface=`` (a surface of the container, as for electrodes)
+    sources : list of ``yade_electro.network.transient.HeatSource`` (heat generated inside the solid,
+        W or W/m^3, shared by element volume)
+    thermal_dt : float, optional; time_scale : float
+    steady : bool
+        Each call solves the steady temperatures (with the Joule heat, sources and boundary
+        conditions of that moment; the thermal clock does not move) instead of a time step:
+        for a solid, or a bed, whose heat settles faster than it moves. :meth:`steady_state`
+        does the same once, from the script.
+    thermal_solver : linear solver of the implicit heat step ('cg' default)
+    coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
+    walls : dict name -> dict(bodies=ids, temperature=K or None, conductivity=W/(m K)), optional
+        Walls of a granular bed (``bonds='contacts'``): ``Wall``, ``Box`` or facet-mesh bodies,
+        isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.network.transient.ThermalWall``.
+        Their heat is in the history (``wall_heat:<name>``) and in :meth:`wall_heat`.
+    skin : Verlet skin of the granular mode (see ElectricalEngine)
+    materials : dict YADE material -> dict(density=, specific_heat=, conductivity=, resistivity=), optional
+        Elements of several materials: the key is a material of ``O.materials`` (its label, or
+        its index), the values override the engine's for the spheres of that material (the
+        others keep them). Looked up again whenever the element set changes (a full read).
+        Edges take the harmonic mean of their two conductivities and the mean of their
+        resistivities; a wall contact the harmonic mean of the particle's and the wall's.
+    overlap : bool
+        Heat-only engines in the granular mode (``electrodes=None``, ``bonds='contacts'``):
+        run each call's numpy work (the Verlet lists, the walls' overlaps, the conductances,
+        the heat step and the history row) on a worker thread while YADE steps on, so that a
+        call pauses YADE's loop only to read the scene and write temperatures (default False).
+        The price is a lag of one call: the temperatures a call computes reach ``b.state.temp``
+        (and ``yade.plot``) at the next call. The engine's own results (``temperature``,
+        ``wall_heat``, ``coupled``, ...) and :meth:`sync` wait for the last call and publish
+        it; a scene saved in between holds the unpublished call's input, so a loaded run
+        continues exactly as an uninterrupted one. The history row is written as soon as the
+        call is computed. See the README (*Granular mode*) for when it pays.
+    """
+
+    DEFAULT_LABEL = "electrothermal"
+
+    #: the call computed on the worker thread and not yet published (overlap=True)
+    _inflight = None
+    overlap = False
+
+    def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
+                 temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(),
+                 flux=(), convection=(),
+                 sources=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
+                 coupled_options=None, law=None,
+                 law_params=None, solver="auto", measure=None, iterPeriod: int = 1, history: Optional[str] = None,
+                 history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
+                 move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
+                 sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
+                 label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
+                 materials=None, overlap=False, O=None, _resume=None):
+        if not isinstance(overlap, bool):
+            raise ValueError(f"overlap must be True or False, got {overlap!r}")
+        if overlap and (electrodes is not None or bonds != "contacts"):
+            raise ValueError("overlap=True is for heat-only engines in the granular mode (electrodes=None, "
+                             "bonds='contacts'); leave it False here")
+        self._drop_inflight()                  # a re-attach in place: the old scene's call is void
+        self.overlap = overlap
+        if overlap and _resume is None:
+            said = overlap_competes(int((O if O is not None else import_yade().Omega()).numThreads), available_cores())
+            if said:
+                warnings.warn(said, stacklevel=3)
+        self._resumed_work = None
+        wall_specs = self._wall_specs(walls)
+        reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
+                              full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
+                              skin=skin, walls={w.name: ids for w, ids in wall_specs if w.isothermal} or None)
+        self._electrode_walls = electrode_walls(electrodes)
+        clash = set(self._electrode_walls) & {w.name for w, _ in wall_specs}
+        if clash:
+            raise BoundaryConditionError(f"{sorted(clash)} name both a thermal wall and an electrode; give them "
+                                         "different names (they may be the same bodies)")
+        if self._electrode_walls:
+            reader_options["walls"] = {**(reader_options["walls"] or {}), **self._electrode_walls}
+        self._options_bonds = bonds
+        self._walls = {w.name: dict(bodies=list(ids), temperature=w.temperature, conductivity=w.conductivity)
+                       for w, ids in wall_specs}
+        self._declared_walls = list(self._electrode_walls) + list(self._walls)     # adiabatic ones too
+        self._heat_only = electrodes is None
+        self._start(O, label, _resume, iterPeriod, reader_options, history, history_mode,
+                    write_back if electrodes is not None else None, plot)
+        for w, ids in wall_specs:
+            check_wall_bodies(self.O, w.name, ids)
+        allowed = ("density", "specific_heat", "conductivity") + (("resistivity",) if electrodes is not None else ())
+        self._materials = material_table(self.O, materials, allowed)
+        self._materials_config = materials
+        self._pending_temperatures: Dict[int, float] = {}
+        law, law_params = self._law_and_container(law, law_params, container)
+        self._options = dict(law=law, solver=solver, measure=measure, reselect=reselect, **reader_options)
+        if temperature is None:
+            raise ValueError("give the initial temperature= (K)")
+        if electrodes is not None:
+            self.model = self._make_electrical(resistivity, electrodes, law, law_params, solver, measure, reselect)
+        else:
+            self.model = None
+            self._law_params = law_params
+            self._resistivity = resistivity
+        if thermal_dt is not None:
+            thermal_dt = real_number("thermal_dt (s)", thermal_dt)
+            if not thermal_dt > 0:
+                raise ValueError(f"thermal_dt must be > 0 (s), got {thermal_dt}")
+        time_scale = real_number("time_scale", time_scale)
+        if not time_scale > 0:
+            raise ValueError(f"time_scale must be > 0, got {time_scale}")
+        self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
+        bcs = []
+        for group, cls in ((fixed, FixedTemperature), (flux, HeatFlux), (convection, Convection)):
+            out = []
+            for bc in group:
+                if not isinstance(bc, cls):
+                    raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.network.transient), got {bc!r}")
+                out.append(bc if bc.nodes is None else dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
+            bcs.append(out)
+        heat_sources = []
+        for src in sources:
+            if not isinstance(src, HeatSource):
+                raise TypeError(f"expected HeatSource objects (yade_electro.network.transient) in sources=, got {src!r}")
+            heat_sources.append(src if src.nodes is None else dataclasses.replace(
+                src, nodes=self._normalise_selector(src.nodes)))
+        if not isinstance(steady, bool):
+            raise ValueError(f"steady must be True or False, got {steady!r}")
+        self.steady = steady
+        self._thermal = dict(density=density, specific_heat=specific_heat, conductivity=conductivity,
+                             temperature=temperature, beta=beta, eta=eta, theta=theta, thermal_dt=thermal_dt,
+                             time_scale=time_scale, thermal_solver=thermal_solver, steady=steady,
+                             coupled_options=dict(coupled_options or {}), overlap=overlap)
+        extra = dict(coupled_options or {})
+        if bonds == "contacts" and "cell_volume" not in extra:
+            extra.setdefault("volume_fraction", 1.0)     # a particle is its own volume
+        if self.model is None:
+            extra.setdefault("law", law)
+            extra.setdefault("law_params", self._law_params)
+        extra.setdefault("container", self.container)
+        self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
+                                           eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
+                                           sources=heat_sources, thermal_solver=thermal_solver,
+                                           walls=[w for w, _ in wall_specs], **extra)
+        self._last_time = float(self.O.time)
+        self._temperature_writer = TemperatureWriter()
+        if initial_temperature is not None and _resume is None:
+            self.coupled.restore_temperatures(self._initial_temperatures(initial_temperature, temperature))
+        if _resume is not None:
+            st = self._resume_state
+            self._last_time = float(st.get("mech_time", self._last_time))
+            self.coupled.restore(st.get("thermal_time", 0.0), st.get("energy"))
+            self.coupled.restore_temperatures(self._read_temperatures)
+            self._pending_temperatures = {int(k): float(v) for k, v in (st.get("pending") or {}).items()}
+            saved_call = persistence.load_call(self.O, self.label) if st.get("overlap_iter") is not None else None
+            if saved_call is not None:
+                self._resumed_work = OverlapWork.saved(saved_call)
+        self._finish(history_mode)
+
+    # -- the model, and the overlapped call -----------------------------------------------
+    coupled = synced_property("_coupled", "The engine's ElectroThermalModel (up to date with the last call).")
+    reader = synced_property("_reader", "The engine's scene reader (its graph is the last call's).")
+    history = synced_property("_history", "The engine's History (with the last call's row).")
+
+    def sync(self) -> Optional[dict]:
+        """With ``overlap=True``: wait for the last call's work on the worker thread and publish
+        it (temperatures to ``b.state.temp``, ``yade.plot``); returns its history row (None
+        when nothing was pending). A worker's error is raised here. Without overlap: nothing."""
+        return self._publish_inflight(save=True)
+
+    def _publish_inflight(self, save: bool) -> Optional[dict]:
+        if self._inflight is None or getattr(WORKER, "active", False):
+            return None
+        future, bodies = self._inflight
+        self._inflight = None
+        try:
+            out, temperatures = future.result()
+        except Exception as exc:
+            self.error = exc
+            log.error("yade-electro engine %r failed in its overlapped call: %s: %s", self.label,
+                      type(exc).__name__, exc)
+            raise
+        self._publish(bodies, out, temperatures)
+        if save:
+            self._save_state()
+        return out
+
+    def _publish(self, bodies, out, temperatures):
+        """An overlapped call's results to YADE: temperatures [K] to ``bodies``, its row to
+        ``yade.plot`` (the worker already wrote it to the history)."""
+        self._temperature_writer.write(bodies, temperatures)
+        if self.plot:
+            self._plot_row(out)
+
+    def _drop_inflight(self):
+        """Wait for a pending overlapped call and discard it (its scene was replaced)."""
+        if self._inflight is not None:
+            future, _ = self._inflight
+            self._inflight = None
+            future.exception()
+
+    def _executor(self) -> ThreadPoolExecutor:
+        if getattr(self, "_pool", None) is None:
+            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=f"yade-electro-{self.label}")
+        return self._pool
+
+    def remove(self):
+        """Publish a pending overlapped call, then as ``EngineBase.remove``."""
+        try:
+            self.sync()
+        finally:
+            super().remove()
+            if getattr(self, "_pool", None) is not None:
+                self._pool.shutdown(wait=True)
+                self._pool = None
+
+    @staticmethod
+    def _wall_specs(walls):
+        """[(ThermalWall, body ids)] from ``walls={name: dict(bodies=..., temperature=K | None,
+        conductivity=W/(m K))}`` (checked here; the bodies' shapes by the reader)."""
+        if walls is None:
+            return []
+        if not isinstance(walls, dict):
+            raise BoundaryConditionError("walls= must be a dict name -> dict(bodies=ids, temperature=K or None "
+                                         "(adiabatic), conductivity=W/(m K))")
+        out = []
+        for name, spec in walls.items():
+            if not isinstance(spec, dict) or "bodies" not in spec:
+                raise BoundaryConditionError(f"wall {name!r}: give dict(bodies=ids, temperature=K or None, "
+                                             "conductivity=...)")
+            unknown = set(spec) - {"bodies", "temperature", "conductivity"}
+            if unknown:
+                raise BoundaryConditionError(f"wall {name!r}: unknown key(s) {sorted(unknown)}; give bodies=, "
+                                             "temperature=, conductivity=")
+            ids = spec["bodies"]
+            ids = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
+            out.append((ThermalWall(name, spec.get("temperature"), spec.get("conductivity")), ids))
+        return out
+
+    def _feed_walls(self):
+        self._feed_electrode_walls()
+        # adiabatic walls carry no heat: their contacts are not looked for (their bodies are
+        # checked when the engine is built)
+        for name in self._walls:
+            if name not in self.reader.walls:
+                continue
+            self.coupled.set_wall_contacts(name, *self.reader.wall_contacts(name))
+
+    def wall_heat(self) -> Dict[str, float]:
+        """Heat [J] each isothermal wall gave the bed since the start (negative: taken)."""
+        return dict(self.coupled.heat.link_energy)
+
+    def contact_heat_flow(self):
+        """Per contact: (body id pairs (m, 2), conductance G [W/K], heat flow [W] from the
+        first body to the second) of the contacts that conduct now."""
+        e, G, q = self._conducting_contacts()
+        ids = self.body_ids
+        return np.column_stack([ids[e[:, 0]], ids[e[:, 1]]]), G, q
+
+    def _conducting_contacts(self):
+        """(node pairs (m, 2), G [W/K], heat flow [W] from the first node to the second) of the
+        edges that conduct now."""
+        heat = self.coupled.heat
+        on = heat.conductance > 0
+        e, G, T = self.coupled.network.edges[on], heat.conductance[on], heat.temperature
+        return e, G, G * (T[e[:, 0]] - T[e[:, 1]])
+
+    def write_vtk(self, prefix: str) -> Dict[str, str]:
+        """Write the last call's state for ParaView (meshio, ``.vtu``): ``<prefix>_particles.vtu``
+        (points with ``radius`` [m], ``temperature`` [K], ``body_id``, and ``potential`` [V]
+        with electrodes) and ``<prefix>_contacts.vtu`` (a line per conducting contact, cell
+        data ``conductance_W_per_K``, ``heat_flow_W`` from the first body to the second, body
+        ids ``id1``, ``id2``). In a periodic cell, a contact that crosses a face is drawn to
+        the neighbour's image. Returns {'particles': path, 'contacts': path}."""
+        from ..post.vtk import write_bonds, write_elements
+        if self.coupled.heat is None:
+            raise RuntimeError(f"engine {self.label!r} has not run yet: call O.run (or engine.step()) first")
+        graph = self.coupled.network.graph
+        fields = {"temperature": self.coupled.heat.temperature, "body_id": graph.ids.astype(float)}
+        sol = self.coupled.solution
+        if sol is not None:
+            fields["potential"] = sol.potential[:graph.n_nodes]      # (surface electrodes' nodes follow)
+        e, G, q = self._conducting_contacts()
+        return {"particles": write_elements(f"{prefix}_particles.vtu", graph.pos, graph.radius, fields),
+                "contacts": write_bonds(f"{prefix}_contacts.vtu", graph.pos, e,
+                                        {"conductance_W_per_K": G, "heat_flow_W": q,
+                                         "id1": graph.ids[e[:, 0]].astype(float),
+                                         "id2": graph.ids[e[:, 1]].astype(float)},
+                                        vectors=graph.edge_vectors(e) if graph.shift is not None else None)}
+
+    def _initial_temperatures(self, table, default):
+        """A function graph -> starting temperatures from ``{body id: K}`` (checked now)."""
+        if not hasattr(table, "items"):
+            raise ValueError(f"initial_temperature must be a dict body id -> temperature (K), got {type(table).__name__}")
+        known = {b.id for b in self.O.bodies if b is not None}
+        values = {}
+        for k, v in table.items():
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or int(k) not in known:
+                raise ValueError(f"initial_temperature: {k!r} is not the id of a body of this scene")
+            values[int(k)] = real_number(f"initial_temperature[{k}] (K)", v)
+        t0 = float(default)
+        return lambda graph: np.array([values.get(int(i), t0) for i in graph.ids], dtype=float)
+
+    def _read_temperatures(self, graph):
+        yade = import_yade()
+        bodies = self.reader.bodies
+        if not all(isinstance(b.state, yade.ThermalState) for b in bodies):
+            raise ThermalError(f"engine {self.label!r}: the loaded bodies have no ThermalState, so their temperatures "
+                               "were not saved; cannot continue the thermal run")
+        return np.array([b.state.temp for b in bodies], dtype=float)
+
+    # -- persistence ---------------------------------------------------------------------------
+    def _config_kwargs(self):
+        if self.model is not None:
+            kw = super()._config_kwargs()
+        else:
+            o = self._options
+            kw = dict(resistivity=self._resistivity, electrodes=None, law=o["law"], law_params=self._law_params,
+                      solver="auto", measure=None, iterPeriod=self.iterPeriod, history=self.history_path,
+                      bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
+                      move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
+                      bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=None, plot=self.plot,
+                      reselect=o["reselect"], container=self.container)
+        t = dict(self._thermal)
+        t["walls"] = dict(self._walls) or None
+        t["skin"] = self._options["skin"]
+        t["materials"] = self._materials_config
+        bcs = {}
+        for group in ("fixed", "flux", "convection"):
+            out = []
+            for bc in getattr(self.coupled, group):
+                if bc.surface is not None:
+                    out.append(dataclasses.replace(bc, surface=self.coupled.bc_surfaces[bc.name].saved))
+                else:
+                    ids = self.coupled.bc_memberships[bc.name].ids
+                    out.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
+            bcs[group] = out
+        bcs["sources"] = [src if src.nodes is None else dataclasses.replace(
+            src, nodes=np.asarray(self.coupled.bc_memberships[src.name].ids, dtype=np.int64))
+            for src in self.coupled.heat_sources]
+        kw.update(t)
+        kw.update(bcs)
+        return kw
+
+    def _save_state(self):
+        if self._inflight is not None:
+            state = dict(self._inflight_state)      # the model is the worker's now
+            state["pending"] = {str(k): v for k, v in self._pending_temperatures.items()}
+        else:
+            state = self._state_dict()
+        persistence.save_state(self.O, self.label, state)
+
+    def _state_dict(self) -> dict:
+        heat = self._coupled.heat
+        return {"iter": int(self.O.iter), "time": float(self.O.time), "mech_time": self._last_time,
+                "values": dict(self.model.values) if self.model is not None else {},
+                "thermal_time": self._coupled.time, "energy": self._coupled.energy_ledger,
+                "fixed_values": heat.fixed_values if heat is not None else {},
+                "pending": {str(k): v for k, v in self._pending_temperatures.items()},
+                "rows": len(self.history)}
+
+    def _prepare(self, graph):
+        if self._resume is not None and self.model is not None:
+            for k, v in (self._resume_state.get("values") or {}).items():
+                self.model.set_electrode(k, v)
+        self._feed_walls()
+        self._apply_materials()
+        self.coupled.refresh(graph)
+        if self._resume is not None:
+            for k, v in (self._resume_state.get("fixed_values") or {}).items():
+                self.coupled.heat.set_fixed_temperature(k, v)
+
+    def _material_base(self):
+        t = self._thermal
+        return {"density": t["density"], "specific_heat": t["specific_heat"], "conductivity": t["conductivity"],
+                "resistivity": self._resistivity}
+
+    def _set_properties(self, props):
+        self.coupled.set_material(**props)
+
+    def set_fixed_temperature(self, name: str, temperature: float):
+        """Change a fixed-temperature boundary condition's value from the next call on."""
+        self.coupled.heat.set_fixed_temperature(name, temperature)
+
+    @property
+    def written_attributes(self) -> tuple:
+        return super().written_attributes + ("state.temp",)
+
+    # -- stepping ------------------------------------------------------------------------
+    def steady_state(self) -> dict:
+        """Solve the steady temperatures now (from the script, e.g. before ``O.run``): reads the
+        scene, writes the temperatures (and potentials) back; returns the history row."""
+        return self._guarded(lambda: self._step(steady=True))
+
+    def _step(self, steady=None):
+        if self.overlap and steady is None:
+            return self._step_overlapped()
+        self.sync()
+        graph = self.reader.read()
+        self._apply_materials()
+        pending, self._pending_temperatures = self._pending_temperatures, {}
+        row = self._heat_step(graph, self._call_dt(), steady, pending)
+        self._last_time = float(self.O.time)
+        bodies = self.reader.bodies
+        self._temperature_writer.write(bodies, self.coupled.temperature)
+        sol = self.coupled.solution
+        if self.write_back and sol is not None and sol is not self._written:
+            write_body_attribute(bodies, self.write_back, sol.potential)
+            self._written = sol
+        out = self._row(int(self.O.iter), float(self.O.time), row, graph)
+        self._write_row(out)
+        return out
+
+    def _call_dt(self) -> float:
+        """The thermal step of a call now [s]."""
+        if self.thermal_dt is not None:
+            return self.thermal_dt
+        return (float(self.O.time) - self._last_time) * self.time_scale
+
+    def _heat_step(self, graph, dt, steady, pending) -> dict:
+        """The model's part of a call (numpy only): walls, set temperatures, then a steady
+        solve, a refresh (no time elapsed) or a step of ``dt`` [s]."""
+        self._feed_walls()
+        self._apply_pending_temperatures(graph, pending)
+        if self.steady if steady is None else steady:
+            return self.coupled.steady_state(graph)
+        if dt <= 0:           # first call at the start of a run: nothing to integrate yet
+            return self.coupled.refresh(graph)
+        return self.coupled.step(graph, dt)
+
+    @staticmethod
+    def _row(iteration, mech_time, row, graph) -> dict:
+        out = {"iter": int(iteration), "mech_time": float(mech_time)}
+        out.update(row)
+        out["graph_revision"] = int(graph.revision)
+        return out
+
+    def _step_overlapped(self):
+        """One call with ``overlap=True``: publish the previous call, read the scene, save the
+        state (the published one, plus this call's input), hand the rest to the worker."""
+        if self._resumed_work is not None:          # a loaded scene's call that was not published
+            work, self._resumed_work = self._resumed_work, None
+            self._resume_work(work)
+        self._publish_inflight(save=False)         # the state saved below covers it
+        state = self._state_dict()
+        capture, dt = self.reader.capture(), self._call_dt()
+        self._apply_materials()
+        work = OverlapWork(capture, dt, self._pending_temperatures, int(self.O.iter), float(self.O.time))
+        self._pending_temperatures = {}
+        self._last_time = work.mech_time
+        state["pending"] = {}
+        state["overlap_iter"] = work.iteration
+        persistence.save_call(self.O, self.label, tuple(work))
+        self._inflight_state = state
+        self._inflight = (self._executor().submit(self._compute, work), self.reader.bodies)
+        return None             # (_guarded saves the state)
+
+    def _compute(self, work: "OverlapWork"):
+        """The worker's part of an overlapped call: (history row, temperatures [K])."""
+        WORKER.active = True
+        try:
+            graph = self.reader.advance(work.capture)
+            row = self._heat_step(graph, work.dt, None, work.pending)
+            out = self._row(work.iteration, work.mech_time, row, graph)
+            self.history.append(out)
+            return out, np.array(self._coupled.temperature, dtype=float)
+        finally:
+            WORKER.active = False
+
+    def _resume_work(self, work: "OverlapWork"):
+        """Compute and publish the saved unpublished call of a loaded scene (same spheres)."""
+        if not np.array_equal(work.capture.ids, self.reader.graph.ids):
+            log.warning("engine %r: the spheres changed between the load and the first call; the saved call of "
+                        "iteration %d is not replayed (the next call integrates its interval)", self.label,
+                        work.iteration)
+            return
+        self._publish(self._reader.bodies, *self._compute(work))
+        self._last_time = work.mech_time
+
+    @property
+    def temperature(self) -> np.ndarray:
+        """Temperature [K] of each element, in ``body_ids`` order."""
+        return self.coupled.temperature
+
+    @property
+    def body_ids(self) -> np.ndarray:
+        return self.coupled.network.graph.ids
+
+    @property
+    def temperature_by_id(self) -> Dict[int, float]:
+        return dict(zip(self.body_ids.tolist(), self.coupled.temperature.tolist()))
+
+    def set_temperatures(self, temperatures: Dict[int, float]):
+        """Give chosen spheres a temperature [K] at the next call, before its step:
+        ``{body id: K}``, for spheres the engine has or spheres added since (particles
+        poured in hot: they take it instead of ``temperature``). The heat this adds or takes
+        is in the history's ``particle_heat``, so the balance still closes. A scene saved
+        before that call (``O.save``) keeps them for the run that loads it. Checked now: an
+        id that is not a sphere of this scene (or is masked out), or a temperature that is not
+        a finite number, raises ValueError."""
+        if not hasattr(temperatures, "items"):
+            raise ValueError(f"set_temperatures takes a dict body id -> temperature (K), got "
+                             f"{type(temperatures).__name__}")
+        Sphere = import_yade().Sphere
+        mask = self.reader.mask
+        checked = {}
+        for k, v in temperatures.items():
+            if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+                raise ValueError(f"set_temperatures: {k!r} is not a body id")
+            b = self.O.bodies[int(k)] if 0 <= int(k) < len(self.O.bodies) else None
+            if b is None or not isinstance(b.shape, Sphere) or b.isClump or b.isClumpMember:
+                raise ValueError(f"set_temperatures: body {k!r} is not a sphere of this scene (only spheres carry "
+                                 "temperatures)")
+            if mask is not None and not (b.mask & mask):
+                raise ValueError(f"set_temperatures: body {k} is masked out of this engine (mask={mask})")
+            checked[int(k)] = real_number(f"set_temperatures[{k}] (K)", v)
+        self._pending_temperatures.update(checked)
+        self._save_state()                  # an O.save before the next call keeps them
+
+    def _apply_pending_temperatures(self, graph, pending):
+        if not pending:
+            return
+        ids = np.array(sorted(pending), dtype=np.int64)
+        here = np.isin(ids, graph.ids)
+        if not np.all(here):
+            log.warning("engine %r: set_temperatures for bodies %s that left the scene before the call; dropped",
+                        self.label, ids[~here][:10].tolist())
+        self.coupled.prepare(graph)
+        self.coupled.set_temperatures(graph.index_of(ids[here]), [pending[int(i)] for i in ids[here]])
