@@ -30,7 +30,7 @@ def main(argv=None):
     ap.add_argument("--ratios", default="10,30")
     args = ap.parse_args(argv)
     import numpy as np
-    from yade_electro.geometry import contacts as contacts
+    from yade_electro.geometry import contacts
     rng = np.random.default_rng(1)
     n = args.n
     side = (n * 8e-9 * 1.9) ** (1 / 3)            # r = 1 mm spheres at about 55 % of the box

@@ -70,9 +70,9 @@ def test_sweeps_print_runs_done_and_time_left(tmp_path, capsys):
 
 
 def test_tessellation_slabs_report_through_the_same_reporter(monkeypatch, capsys):
-    from yade_electro.geometry import voronoi as voronoi
+    from yade_electro.geometry import ghosts
     monkeypatch.setattr(P, "PROGRESS_EVERY", 0.0)
-    report = voronoi._progress_lines(1234)
+    report = ghosts.progress_lines(1234)
     report(1, 4, 0.1)
     report(4, 4, 0.2)
     err = capsys.readouterr().err.splitlines()

@@ -110,7 +110,7 @@ def test_thread_setting(monkeypatch):
 
 
 def test_cgal_and_qhull_give_the_same_faces(monkeypatch, capsys):
-    from yade_electro.core import progress as progress
+    from yade_electro.core import progress
     from yade_electro.native import cgal_executable
     cgal_executable()                                # built here (make install brings g++ and CGAL)
     pts, n = _cloud(5000, 3)

@@ -18,7 +18,7 @@ from yade_electro.geometry.surfaces import Plane
 from yade_electro.packing import bond_pairs, dense_packing
 from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux
 from yade_electro.network.conditions import HeatSource
-from yade_electro.geometry.voronoi import bounded_cells
+from yade_electro.geometry.bounded_cells import bounded_cells
 
 R, L = 1e-3, 5e-3
 LAM, RHO, CP = 15.0, 7900.0, 500.0
