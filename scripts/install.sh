@@ -32,13 +32,18 @@ DEB_PACKAGES=(
   g++ libeigen3-dev
   python3-petsc4py python3-mpi4py openmpi-bin
   libcgal-dev
+  python3-threadpoolctl
+  python3-click python3-typing-extensions
+  python3-sphinx python3-numpydoc python3-myst-parser
 )
 
 # PyPI packages Debian 12 lacks, pinned to the newest release that declares support for
 # Debian 12's scipy 1.10 / numpy 1.24 (checked with a solve in verify_python_stack):
 # - pyamg 5.1.0: 5.2.x needs scipy>=1.11 (metadata), 5.3+ imports scipy.sparse.eye_array (1.12+).
 # - scikit-fem 12.0.2: pure Python, requires only numpy and scipy.
-PIP_PINS=(pyamg==5.1.0 scikit-fem==12.0.2)
+# The checks of `make lint` (their other dependencies, click and typing-extensions, are Debian's):
+# - ruff 0.8.6: a static binary; import-linter 2.1 with grimp 3.5 (a compiled wheel for cp311).
+PIP_PINS=(pyamg==5.1.0 scikit-fem==12.0.2 ruff==0.8.6 import-linter==2.1 grimp==3.5)
 
 DRY_RUN=0
 for arg in "$@"; do
@@ -124,7 +129,7 @@ for pin in "${PIP_PINS[@]}"; do
 done
 if [ "${#to_install[@]}" -gt 0 ]; then
   # --no-deps: their only dependencies, numpy and scipy, are Debian's and must stay so.
-  run "${PIP[@]}" --no-deps --only-binary=pyamg "${to_install[@]}" \
+  run "${PIP[@]}" --no-deps --only-binary=pyamg,ruff,grimp "${to_install[@]}" \
     || die "pip install failed for: ${to_install[*]}"
 fi
 
@@ -166,15 +171,17 @@ basis = Basis(MeshTet().refined(2), ElementTetP1())
 u = solve(*condense(laplace.assemble(basis), unit_load.assemble(basis),
                     D=basis.mesh.boundary_nodes()))
 assert 0.0 < u.max() < 0.1, "scikit-fem Poisson solve gave %r" % u.max()
-# petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.solvers.petsc finds it)
-from yade_electro.solvers.petsc import import_petsc
-PETSc = import_petsc()
+# petsc4py: Debian puts it under /usr/lib/petscdir (yade_electro.solvers.petsc finds it). Found,
+# not imported: importing it outside mpiexec starts an MPI singleton that listens on the network.
+from yade_electro.solvers.petsc import petsc4py_location
+petsc_dir = petsc4py_location()
+assert petsc_dir, "petsc4py not found (apt-get install python3-petsc4py)"
 # the CGAL Delaunay helper: built now, once, so that the first 'voronoi' run does not wait
 from yade_electro.native import cgal_executable
 cgal_executable()
-print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; PETSc %s; yade_electro from %s"
-      % (numpy.__version__, scipy.__version__, pyamg.__version__, skfem.__version__,
-         ".".join(map(str, PETSc.Sys.getVersion())), importlib.util.find_spec("yade_electro").origin))
+print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; petsc4py in %s; yade_electro from %s"
+      % (numpy.__version__, scipy.__version__, pyamg.__version__, skfem.__version__, petsc_dir,
+         importlib.util.find_spec("yade_electro").origin))
 EOF
 command -v yade >/dev/null 2>&1 || die "yade not on PATH after installing the Debian package"
 command -v yade-electro >/dev/null 2>&1 || die "yade-electro (the launcher without open ports) not on PATH after the install"

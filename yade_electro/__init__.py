@@ -37,7 +37,7 @@ from .physics import (ElectricalModel, ElectrodeSpec, ElectroThermalModel, heat_
                       joule_sources, thermal_conductance)
 from .post import (element_gradients, line_probe, plane_probe, probe, region_mean, section_mean, slab_means)
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 __all__ = [
     # errors

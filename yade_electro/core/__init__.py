@@ -7,10 +7,10 @@ from .history import History
 from .materials import Material, positive_property, real_number, edge_resistivity, edge_conductivity
 from .progress import PROGRESS_EVERY, Progress
 from .selection import Selector, check_selector, select_nodes, Membership
-from .threads import blas_library, blas_threads, limit_blas_threads, apply_default_limit
+from .threads import blas_threads, limit_blas_threads, apply_default_limit
 
 __all__ = ["ElectroError", "GraphError", "BoundaryConditionError", "MaterialError", "SolverError",
            "ThermalError", "ContactGraph", "History", "Material", "positive_property", "real_number",
            "edge_resistivity", "edge_conductivity", "PROGRESS_EVERY", "Progress", "Selector",
-           "check_selector", "select_nodes", "Membership", "blas_library", "blas_threads",
-           "limit_blas_threads", "apply_default_limit"]
+           "check_selector", "select_nodes", "Membership", "blas_threads", "limit_blas_threads",
+           "apply_default_limit"]

@@ -52,16 +52,15 @@ packings are the same to the last bit (a test compares them).
 """
 from __future__ import annotations
 
-import hashlib
 import os
-import shutil
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 from typing import Optional
 
 import numpy as np
+
+from .build import HERE, NativeError, build as _build, cache_dir, shared_function as _shared_function  # noqa: F401
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
@@ -69,42 +68,7 @@ __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked"
            "pair_lengths",
            "continuum_factors", "csr_pattern"]
 
-HERE = Path(__file__).resolve().parent
 CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
-
-
-class NativeError(RuntimeError):
-    """A compiled helper could not be built or failed."""
-
-
-def cache_dir() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "yade-electro"
-
-
-def _build(src: Path, name: str, libs, shared: bool = False) -> Path:
-    cache = cache_dir()
-    cache.mkdir(parents=True, exist_ok=True)
-    tag = hashlib.sha1(src.read_bytes()).hexdigest()[:12]        # the source's content, not its mtime
-    exe = cache / (f"lib{name}_{tag}.so" if shared else f"{name}_{tag}")
-    if exe.exists():
-        return exe
-    cxx = shutil.which("g++")
-    if cxx is None:
-        raise NativeError("g++ not found (apt-get install g++; `make install` does)")
-    print(f"[yade-electro] building {name} (once, {'a few seconds' if shared else 'about 15 s'}) into {cache}",
-          file=sys.stderr, flush=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}_", dir=str(cache))
-    os.close(fd)
-    cmd = [cxx, "-O2", "-std=c++17", "-DNDEBUG"] + (["-shared", "-fPIC"] if shared else []) + ["-o", tmp, str(src)] \
-        + list(libs)
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        os.unlink(tmp)
-        raise NativeError(f"building {name} failed:\n{' '.join(cmd)}\n{r.stderr[-2000:]}")
-    os.chmod(tmp, 0o755)
-    os.replace(tmp, exe)
-    return exe
 
 
 _CGAL = {}
@@ -184,27 +148,6 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
     if around.size != ni or counts.sum() != ni:
         raise NativeError("delaunay_cgal: short output")
     return cells, cc, pairs, counts, around
-
-
-_LIBRARIES = {}
-
-
-def _shared_function(name: str, symbol: str, argtypes, restype, flags=()):
-    """The function ``symbol`` of the shared library built from ``<name>.cpp``, loaded once
-    with ctypes (raises :class:`NativeError`, kept for later calls, when it cannot be built)."""
-    key = (name, symbol)
-    if key not in _LIBRARIES:
-        try:
-            import ctypes
-            lib = ctypes.CDLL(str(_build(HERE / f"{name}.cpp", name, list(flags), shared=True)))
-            f = getattr(lib, symbol)
-            f.argtypes, f.restype = argtypes, restype
-            _LIBRARIES[key] = f
-        except (NativeError, OSError, AttributeError) as exc:
-            _LIBRARIES[key] = NativeError(f"{name}: {exc}")
-    if isinstance(_LIBRARIES[key], Exception):
-        raise _LIBRARIES[key]
-    return _LIBRARIES[key]
 
 
 def _hops_library():

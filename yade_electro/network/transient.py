@@ -1,25 +1,11 @@
-"""The transient (and steady) heat network: the theta-method integrator, its stability bound and results.
+"""The heat network in time: ``C dT/dt = -M T + s``, integrated by the theta method (paper 003).
 
-The lumped heat balance of a packing (paper 000 eq. 13 and 16, paper 003 eq. 14):
-
-    C_i dT_i/dt = P_i + sum_j G_ij (T_j - T_i) + h_i A_i (T_inf,i - T_i) + Q_i
-
-* ``C_i = rho c V_i / fv_i`` [J/K], the heat capacity of the volume the element stands for
-  (:func:`heat_capacity`);
-* ``P_i`` [W], half the Joule power ``eta w_ij^2 / c_ij`` of every bond of i
-  (:func:`joule_sources`);
-* ``G_ij = lambda S_ij / l_ij`` [W/K], the thermal conductance; any electrical conductance
-  law gives it when called with the thermal resistivity 1/lambda
-  (:func:`thermal_conductance`; the 'continuum' law gives exactly paper 000 eq. 16);
-* convection ``h A (T_inf - T)`` on free-surface elements and imposed heat inputs ``Q_i``
-  [W]; fixed-temperature node sets take the place of electrodes.
-
-In matrix form ``C dT/dt = -M T + s`` with ``M = K + diag(h A)`` (K the Laplacian of G) and
-``s = P + Q + h A T_inf``. :class:`HeatSolver` integrates it with the theta family (paper
-003): ``(C/dt + theta M) T^{n+1} = (C/dt - (1 - theta) M) T^n + s``, sources constant over
-the step; ``theta = 0`` is forward Euler (no solve), ``1/2`` Crank-Nicolson, ``1`` backward
-Euler. Fixed-temperature nodes are eliminated from the unknowns.
-
+``M = K + diag(h A)`` (K the Laplacian of the conductances G, h A the convection) and
+``s = P + Q + h A T_inf`` (sources, imposed inputs, ambient); the physics of each term is in
+:mod:`yade_electro.physics.thermal`. :class:`HeatSolver` takes
+``(C/dt + theta M) T^{n+1} = (C/dt - (1 - theta) M) T^n + s``, sources constant over the step;
+``theta = 0`` is forward Euler (no solve), ``1/2`` Crank-Nicolson, ``1`` backward Euler.
+Fixed-temperature nodes are eliminated from the unknowns.
 Stability of the explicit scheme
 --------------------------------
 Forward Euler keeps every new temperature a convex combination of the old ones (so no
@@ -408,7 +394,7 @@ class HeatSolver:
             raise ThermalError(
                 f"time step {dt:.6g} s is above the stable step of the theta={self.theta:g} scheme "
                 f"({allowed:.6g} s = safety {self.safety:g} x dt_crit {self.critical_time_step:.6g} s"
-                f"{'' if self.theta == 0 else f' / (1 - 2 theta)'}); reduce dt, allow sub-cycling "
+                f"{'' if self.theta == 0 else ' / (1 - 2 theta)'}); reduce dt, allow sub-cycling "
                 "(subcycle=True) or use theta='backward-euler'")
         n_sub = int(math.ceil(dt / allowed))
         if n_sub > self.max_substeps:

@@ -4,8 +4,8 @@ capacities, Joule sources) and the coupled electro-thermal model (the one owner 
 from .coupled import ElectroThermalModel
 from .electrical import ElectrodeSpec, ElectricalModel, electrode_specs
 from .thermal import (heat_capacity, thermal_conductance, diffusion_time_step, edge_joule_power,
-                      joule_sources, electrical_power, heat_solver_on_graph)
+                      joule_sources, electrical_power, heat_solver_on_graph, surface_conditions, source_power)
 
 __all__ = ["ElectroThermalModel", "ElectrodeSpec", "ElectricalModel", "electrode_specs", "heat_capacity",
            "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
-           "electrical_power", "heat_solver_on_graph"]
+           "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power"]

@@ -39,17 +39,16 @@ import numpy as np
 from ..geometry.contacts import new_wall_contacts
 from ..laws.conductance import FactorNetwork, make_law
 from .electrical import ElectricalModel
-from ..core.errors import MaterialError
+from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
 from ..core.history import History
 from ..core.materials import Material, edge_conductivity, real_number
 from ..core.selection import Membership
 from ..geometry.surface_contact import BoundaryOfGraph, SurfaceMembership
-from ..network.conditions import Convection, FixedTemperature, HeatFlux
+from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
 from ..network.transient import HeatSolver
 from ..network.theta import theta_of
-from ..network.conditions import HeatSource, ThermalWall
-from .thermal import diffusion_time_step, heat_capacity
+from .thermal import diffusion_time_step, heat_capacity, source_power, surface_conditions
 
 __all__ = ["ElectroThermalModel"]
 
@@ -139,7 +138,6 @@ class ElectroThermalModel:
                     raise TypeError(f"expected {cls.__name__} objects, got {bc!r}")
         names = [b.name for b in self.fixed + self.flux + self.convection]
         if len(set(names)) != len(names):
-            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
         self.heat_sources = list(sources)
         for src in self.heat_sources:
@@ -152,7 +150,6 @@ class ElectroThermalModel:
                 raise TypeError(f"expected ThermalWall objects (yade_electro.network.transient) in walls=, got {w!r}")
         names += [w.name for w in self.walls]
         if len(set(names)) != len(names):
-            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"thermal boundary condition and heat source names must be unique, got {names}")
         everything = self.fixed + self.flux + self.convection
         self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition")
@@ -168,7 +165,6 @@ class ElectroThermalModel:
             try:
                 law_.wall_factor(np.ones(1), np.zeros(1))
             except ValueError as exc:
-                from ..core.errors import BoundaryConditionError
                 raise BoundaryConditionError(f"walls= given with law {law_.name!r}: {exc}") from None
         self._wall_contacts = {w.name: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
         self._walls_applied = None
@@ -293,7 +289,6 @@ class ElectroThermalModel:
         """The spheres touching wall ``name`` now (node indices of the next step's graph) and
         their overlaps [m] (> 0); applied at the next step."""
         if name not in self._wall_contacts:
-            from ..core.errors import BoundaryConditionError
             raise BoundaryConditionError(f"no wall named {name!r}; have {sorted(self._wall_contacts)}")
         new = new_wall_contacts(f"wall {name!r}", self._wall_contacts[name], nodes, overlap)
         if new is None:
@@ -342,19 +337,11 @@ class ElectroThermalModel:
         elif self._T_restore is not None:
             T = self._T_restore(graph)
         nodes_of = {name: m.nodes(graph) for name, m in self.bc_memberships.items()}
-        area_of, link_of = {}, {}
-        lam = np.asarray(self.material.conductivity, dtype=float)
-        for b in self.fixed + self.flux + self.convection:
-            if b.surface is None:
-                continue
-            contact = self.bc_surfaces[b.name].contact(graph, self._boundary)
-            nodes_of[b.name] = contact.nodes
-            if isinstance(b, FixedTemperature):
-                link_of[b.name] = (lam if lam.ndim == 0 else lam[contact.nodes]) * contact.factor
-            elif isinstance(b, Convection):
-                area_of[b.name] = contact.convection_area(b.h, lam)
-            else:
-                area_of[b.name] = contact.area
+        surface_nodes, area_of, link_of = surface_conditions(
+            self.fixed + self.flux + self.convection,
+            {name: m.contact(graph, self._boundary) for name, m in self.bc_surfaces.items()},
+            self.material.conductivity)
+        nodes_of.update(surface_nodes)
         fixed = list(self.fixed)
         for w in self.walls:
             if w.isothermal:
@@ -386,16 +373,9 @@ class ElectroThermalModel:
     def _source_power(self, graph):
         if not self.heat_sources:
             return None
-        vol = self._volumes(graph)
-        q = np.zeros(graph.n_nodes)
-        for src in self.heat_sources:
-            nodes = self.bc_memberships[src.name].nodes(graph) if src.nodes is not None else np.arange(graph.n_nodes)
-            v = vol[nodes]
-            if src.power is not None:
-                np.add.at(q, nodes, src.power * v / v.sum())
-            else:
-                np.add.at(q, nodes, src.density * v)
-        return q
+        nodes = {src.name: self.bc_memberships[src.name].nodes(graph) if src.nodes is not None
+                 else np.arange(graph.n_nodes) for src in self.heat_sources}
+        return source_power(self.heat_sources, nodes, self._volumes(graph))
 
     def set_material(self, **properties):
         """New material data from the next step on: ``density`` [kg/m^3], ``specific_heat``

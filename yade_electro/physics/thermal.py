@@ -14,27 +14,8 @@ The lumped heat balance of a packing (paper 000 eq. 13 and 16, paper 003 eq. 14)
 * convection ``h A (T_inf - T)`` on free-surface elements and imposed heat inputs ``Q_i``
   [W]; fixed-temperature node sets take the place of electrodes.
 
-In matrix form ``C dT/dt = -M T + s`` with ``M = K + diag(h A)`` (K the Laplacian of G) and
-``s = P + Q + h A T_inf``. :class:`HeatSolver` integrates it with the theta family (paper
-003): ``(C/dt + theta M) T^{n+1} = (C/dt - (1 - theta) M) T^n + s``, sources constant over
-the step; ``theta = 0`` is forward Euler (no solve), ``1/2`` Crank-Nicolson, ``1`` backward
-Euler. Fixed-temperature nodes are eliminated from the unknowns.
-
-Stability of the explicit scheme
---------------------------------
-Forward Euler keeps every new temperature a convex combination of the old ones (so no
-oscillation and no growth) when ``dt <= dt_crit = min_i C_i / M_ii`` over the free nodes
-(:func:`stable_time_step`, the diagonal/Gershgorin bound; for two equal elements it is
-exactly the stability limit C/G). For ``theta < 1/2`` the bound is ``dt_crit / (1 - 2
-theta)``. A requested step above ``safety * bound`` is split into ``n_sub = ceil(dt /
-(safety * bound))`` equal sub-steps, or raises :class:`ThermalError` when sub-cycling is
-off. Paper 000 eq. 14 quotes ``l_min^2 / (2 alpha)``, alpha = lambda / (rho c)
-(:func:`diffusion_time_step`); it ignores the volume fractions, the surfaces and the
-number of neighbours (it is the 1D bound), so it is reported for comparison only: on a simple
-cubic lattice the lumped bound is about 4x smaller (interior elements C/sum G = (2/3) r^2 /
-alpha against the paper's 2 r^2 / alpha; edge and corner elements lower still), so a step
-taken from eq. 14 alone would be unstable. ``theta >= 1/2`` has no step limit; only ``theta = 1`` keeps
-the maximum principle at any step (Crank-Nicolson oscillates for steps far above dt_crit).
+The network integrates it in time (:mod:`yade_electro.network.transient`, with the explicit
+stability bound) or solves its steady state.
 
 Units: SI (kg/m^3, J/(kg K), W/(m K), W/(m^2 K), K or degC, J/K, W, s).
 """
@@ -50,10 +31,11 @@ from ..core.materials import edge_conductivity, positive_property
 from ..laws.conductance import make_law
 from ..laws.transmission import volume_fraction as _volume_fraction
 from ..network.kirchhoff import edge_power
+from ..network.conditions import Convection, FixedTemperature
 from ..network.transient import HeatSolver
 
 __all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
-           "electrical_power", "heat_solver_on_graph"]
+           "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power"]
 
 
 # ---------------------------------------------------------------------------------------
@@ -172,3 +154,55 @@ def heat_solver_on_graph(graph: ContactGraph, density, specific_heat, conductivi
     G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
     kw.setdefault("coords", graph.pos)
     return HeatSolver(C, graph.edges, G, temperature, graph=graph, **kw)
+
+
+# ---------------------------------------------------------------------------------------
+# conditions on surfaces, heat sources
+# ---------------------------------------------------------------------------------------
+def surface_conditions(conditions, contacts: dict, conductivity):
+    """The node sets, areas and link conductances of the thermal conditions given on a surface.
+
+    Parameters
+    ----------
+    conditions : sequence of FixedTemperature, HeatFlux and Convection; those with no
+        ``surface`` are skipped
+    contacts : dict name -> :class:`~yade_electro.geometry.surface_contact.SurfaceContact`
+        of each surface condition on the current graph
+    conductivity : float or (n,) [W/(m K)]
+
+    Returns
+    -------
+    nodes_of, area_of, link_of : dicts name -> node indices; areas [m^2] (a flux's boundary
+        faces, a convection's area in series with the half cells); conductances [W/K] of a
+        fixed temperature held at the surface (``lambda sum_f A_f / d_f`` per node)
+    """
+    lam = np.asarray(conductivity, dtype=float)
+    nodes_of, area_of, link_of = {}, {}, {}
+    for b in conditions:
+        if b.surface is None:
+            continue
+        contact = contacts[b.name]
+        nodes_of[b.name] = contact.nodes
+        if isinstance(b, FixedTemperature):
+            link_of[b.name] = (lam if lam.ndim == 0 else lam[contact.nodes]) * contact.factor
+        elif isinstance(b, Convection):
+            area_of[b.name] = contact.convection_area(b.h, lam)
+        else:
+            area_of[b.name] = contact.area
+    return nodes_of, area_of, link_of
+
+
+def source_power(sources, nodes_of: dict, volume) -> np.ndarray:
+    """Heat generated inside the solid per node [W]: each :class:`HeatSource`'s ``power`` [W]
+    shared by element volume over its nodes ``nodes_of[name]``, or its ``density`` [W/m^3]
+    times each element's volume ``volume`` [m^3]."""
+    volume = np.asarray(volume, dtype=float)
+    q = np.zeros(volume.shape[0])
+    for src in sources:
+        nodes = nodes_of[src.name]
+        v = volume[nodes]
+        if src.power is not None:
+            np.add.at(q, nodes, src.power * v / v.sum())
+        else:
+            np.add.at(q, nodes, src.density * v)
+    return q

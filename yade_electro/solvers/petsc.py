@@ -36,13 +36,26 @@ import scipy.sparse as sp
 from ..core.errors import SolverError
 from .base import Solver
 
-__all__ = ["PETScSolver", "import_petsc", "petsc_available"]
+__all__ = ["PETScSolver", "import_petsc", "petsc_available", "petsc4py_location"]
 
 #: where Debian 12's python3-petsc4py puts the module (one directory per PETSc build)
 DEBIAN_PETSC4PY = "/usr/lib/petscdir/petsc*/*-real/lib/python3/dist-packages"
 
 _INSTALL_HINT = ("solver='petsc' needs petsc4py and mpi4py: `apt-get install python3-petsc4py python3-mpi4py` "
                  "(or `make install`), or use solver='cg-deflated'")
+
+
+def petsc4py_location() -> Optional[str]:
+    """The directory that holds the ``petsc4py`` package, found without importing it (importing
+    it outside ``mpiexec`` starts an MPI singleton); None when it is not installed."""
+    import importlib.util
+    spec = importlib.util.find_spec("petsc4py")
+    if spec is not None and spec.origin:
+        return os.path.dirname(os.path.dirname(spec.origin))
+    for path in sorted(glob.glob(DEBIAN_PETSC4PY), reverse=True):
+        if os.path.isdir(os.path.join(path, "petsc4py")):
+            return path
+    return None
 
 
 def import_petsc():
