@@ -53,7 +53,7 @@ def bench_size(n, repeat=5, seed=1):
     from yade_electro.physics.coupled import ElectroThermalModel
     from yade_electro.physics.electrical import ElectricalModel
     from yade_electro.geometry.shapes import Cylinder
-    from yade_electro.yade import ElectroThermalEngine, SceneReader
+    from yade_electro.yade import ElectroThermalEngine, SceneReader, Electrode, Integrator, Material
     import joule_rod as jr
     import rod_resistance as rod
 
@@ -101,10 +101,14 @@ def bench_size(n, repeat=5, seed=1):
     out["dt_critical_ms"] = models["unchanged"].time_steps()["critical"] * 1e3
 
     # the engine's whole PyRunner call
-    engine = ElectroThermalEngine(rod.RHO_304L, {"top": dict(select=ids[top], potential=1.0),
-                                                 "bottom": dict(select=ids[bottom], potential=0.0)},
-                                  jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, thermal_dt=DT,
-                                  theta="backward-euler", label="bench_coupled")
+    engine = ElectroThermalEngine(
+        material=Material(resistivity=rod.RHO_304L, density=jr.DENSITY, specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY),
+        boundaries=[
+            Electrode("top", select=ids[top], potential=1.0),
+            Electrode("bottom", select=ids[bottom], potential=0.0)],
+        temperature=jr.T0,
+        integrator=Integrator(theta="backward-euler", dt=DT),
+        label="bench_coupled")
     t = time.perf_counter()
     engine.step()
     out["engine_call_first_ms"] = time.perf_counter() - t

@@ -65,17 +65,25 @@ def setup_pull(O, ids, top, bottom, total_steps, length):
 def make_engine(kind, law, period, ids, top, bottom):
     import joule_rod as jr
     import rod_resistance as rod
-    from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
+    from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, Integrator, Law, Material, electrodes_from_dict
     from yade_electro.geometry.shapes import Cylinder
     el = {"top": dict(select=ids[top], potential=1.0), "bottom": dict(select=ids[bottom], potential=0.0)}
     lp = {"container": Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)} if law == "voronoi" else None
     if kind == "ElectricalEngine":
-        return ElectricalEngine(resistivity=rod.RHO_304L, electrodes=el, law=law, law_params=lp, iterPeriod=period,
-                                label=f"live_{law}_{period}")
-    return ElectroThermalEngine(resistivity=rod.RHO_304L, electrodes=el, density=jr.DENSITY,
-                                specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY, temperature=jr.T0,
-                                law=law, law_params=lp, iterPeriod=period, thermal_dt=1e-5,
-                                label=f"live_thermal_{law}_{period}")
+        return ElectricalEngine(
+            material=Material(resistivity=rod.RHO_304L),
+            boundaries=electrodes_from_dict(el),
+            law=Law(law, **(lp or {})),
+            iterPeriod=period,
+            label=f"live_{law}_{period}")
+    return ElectroThermalEngine(
+        material=Material(resistivity=rod.RHO_304L, density=jr.DENSITY, specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY),
+        boundaries=electrodes_from_dict(el),
+        temperature=jr.T0,
+        law=Law(law, **(lp or {})),
+        integrator=Integrator(dt=1e-5),
+        iterPeriod=period,
+        label=f"live_thermal_{law}_{period}")
 
 
 def timed(engine, times, kinds):

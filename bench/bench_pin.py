@@ -30,7 +30,7 @@ from _benchlib import BLOCK_TIMER, run_steps  # noqa: E402
 
 def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block=400, blocks=3):
     import pin_torsion as PT
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Law, Material, Output, Reader, electrodes_from_dict
     cal = PT.load_calibration(n, seed)
     rate = PT.paper_rate()
     pin = PT.build_pin(n, seed, cal["young"], cal["strength"], rate=rate, ramp_time=2 * PT.RAMP_ANGLE / rate)
@@ -40,8 +40,14 @@ def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block
     for law in laws:
         for period in periods:
             el, params = PT.pin_electrodes(pin, law)
-            eng = ElectricalEngine(PT.RESISTIVITY, el, law=law, law_params=params, container=cyl, iterPeriod=period,
-                                   bond_check="flags", write_back=None, label=f"bench_{law}_{period}")
+            eng = ElectricalEngine(
+                material=Material(resistivity=PT.RESISTIVITY),
+                boundaries=electrodes_from_dict(el),
+                law=Law(law, **(params or {}), container=cyl),
+                reader=Reader(bond_check="flags"),
+                output=Output(write_back=None),
+                iterPeriod=period,
+                label=f"bench_{law}_{period}")
             O.engines = O.engines + [eng.runner]
             O.step()                                   # the first call builds everything: not timed
             wall = {True: 0.0, False: 0.0}

@@ -13,7 +13,7 @@ degC and heats the static bed from 0 degC by conduction only. Here:
   (FrictMat, E = 1e8 Pa, friction 0.5, damping 0.3) until the kinetic energy is below
   1e-8 of its peak or ``--settle`` s. Then the mechanics stop: the bed is static (paper 003
   has no thermal expansion).
-* Heat: ``HeatEngine(bonds='contacts', law='contact')`` (H = 2 k a, geometric contact radius
+* Heat: ``HeatEngine(material=Material(), law='contact', reader=Reader(bonds='contacts'))`` (H = 2 k a, geometric contact radius
   of the settled overlaps), both walls isothermal at 300 degC from t = 0, the particles from
   0 degC, Crank-Nicolson with ``--dt`` (1 s); the engine is stepped from the script
   (``engine.step()``, what its PyRunner calls) while the scene stays still.
@@ -98,11 +98,17 @@ def fill_container(n=2000, seed=1, settle=1.0, verbose=True):
 
 
 def heat_engine(ids, dt, label="container_heat"):
-    from yade_electro.yade import HeatEngine
-    return HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T_START, bonds="contacts", law="contact",
-                      walls={"side": dict(bodies=ids["side"], temperature=T_WALL),
-                             "bottom": dict(bodies=ids["bottom"], temperature=T_WALL)},
-                      theta="crank-nicolson", thermal_dt=dt, label=label)
+    from yade_electro.yade import HeatEngine, Integrator, Material, Reader, Wall
+    return HeatEngine(
+        material=Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        boundaries=[
+            Wall("side", bodies=ids["side"], temperature=T_WALL),
+            Wall("bottom", bodies=ids["bottom"], temperature=T_WALL)],
+        temperature=T_START,
+        law="contact",
+        integrator=Integrator(theta="crank-nicolson", dt=dt),
+        reader=Reader(bonds="contacts"),
+        label=label)
 
 
 def centre_nodes(pos, r=PARTICLE_RADIUS):

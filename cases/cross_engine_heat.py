@@ -14,7 +14,7 @@ Two problems, both on particles that do not move (the contacts are fixed):
   lower half (z below the median) starts at 100 degC, the rest at 0 degC, 1 s.
 
 LIGGGHTS integrates T with explicit Euler at its time step; the YADE side is
-``HeatEngine(bonds='contacts', law='liggghts')`` on the same positions (atom id = body id +
+``HeatEngine(material=Material(), law='liggghts', reader=Reader(bonds='contacts'))`` on the same positions (atom id = body id +
 1), Crank-Nicolson with ``thermal_dt`` = dump interval / ``calls_per_dump`` (100: 2e-4 s for
 the two spheres, 5e-4 s for the packing, below 1/10 of the fastest particle time C / sum G).
 (The explicit integrator sub-cycles for stability only: one step of 2e-3 s, 1/15 of the
@@ -102,24 +102,28 @@ def yade_run(data, init, mat, times, law, calls_per_dump=100, floor=False):
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()
     from yade import wrapper as W
-    from yade_electro.yade import HeatEngine
+    from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Material, Reader, Wall
     from yade_electro.yade.spheres import add_spheres
     O = yade.Omega()
     O.reset()
     ymat = W.FrictMat(young=mat.young, poisson=mat.poisson, density=mat.density, frictionAngle=math.atan(mat.friction))
     ids = add_spheres(data.positions, data.radius, ymat, fixed=True, O=O)
     body_of_atom = dict(zip(data.ids.tolist(), ids))
-    walls = None
+    walls = []
     if floor:
         from yade import utils
         wall = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=ymat))
-        walls = {"floor": dict(bodies=wall, temperature=T_HOT)}
+        walls = [Wall("floor", bodies=wall, temperature=T_HOT)]
     O.dt = 1e-6                        # nothing moves: the engine alone runs
     interval = float(times[1] - times[0])
-    engine = HeatEngine(mat.density, mat.specific_heat, mat.conductivity, T_COLD,
-                        initial_temperature={body_of_atom[a]: T for a, T in init.items()}, law=law,
-                        bonds="contacts", theta="crank-nicolson", thermal_dt=interval / calls_per_dump,
-                        walls=walls, label=f"cross_{law}", O=O)
+    engine = HeatEngine(
+        material=Material(density=mat.density, specific_heat=mat.specific_heat, conductivity=mat.conductivity),
+        boundaries=walls,
+        temperature=InitialTemperature(T_COLD, by_id={body_of_atom[a]: T for a, T in init.items()}),
+        law=law,
+        integrator=Integrator(theta="crank-nicolson", dt=interval / calls_per_dump),
+        reader=Reader(bonds="contacts"),
+        label=f"cross_{law}")
     O.engines = [engine.runner]
     out = []
     order = np.array(ids)

@@ -82,87 +82,17 @@ def liggghts_bed(n, radius, workdir, ke_threshold, settle_time, seed=32452843):
                "ke_per_particle_J": p.ke_per_particle, "steps": p.step}
 
 
-def random_placement(radii, region, seed=1, max_tries=20000):
-    """Centres for ``radii`` at random in the cylinder ``region`` with no overlap (random
-    sequential addition, larger spheres first; cell lists of the largest diameter)."""
-    rng = np.random.default_rng(seed)
-    order = np.argsort(-radii, kind="stable")
-    cell = 2.0 * float(radii.max())
-    grid, placed = {}, np.zeros((radii.size, 3))
-    shifts = [(dx, dy, dz) for dx in (-1, 0, 1) for dy in (-1, 0, 1) for dz in (-1, 0, 1)]
-
-    def free(p, r, key):
-        """No placed sphere in the 27 cells around ``key`` overlaps a sphere r at p."""
-        return not any(np.sum((placed[j] - p) ** 2) < (r + radii[j]) ** 2
-                       for dx, dy, dz in shifts for j in grid.get((key[0] + dx, key[1] + dy, key[2] + dz), ()))
-
-    for k in order:
-        r = radii[k]
-        for _ in range(max_tries):
-            rho = (region.radius - r) * math.sqrt(rng.random())
-            ang = 2.0 * math.pi * rng.random()
-            p = np.array([rho * math.cos(ang), rho * math.sin(ang), rng.uniform(region.z_low + r, region.z_high - r)])
-            key = tuple((p // cell).astype(int))
-            if free(p, r, key):
-                placed[k] = p
-                grid.setdefault(key, []).append(k)
-                break
-        else:
-            raise RuntimeError(f"no room for sphere {k} (r = {r}) after {max_tries} tries: make the region taller")
-    return placed
-
-
-def yade_bed(radii, radius, ke_threshold, settle_time, seed=1, progress=10.0):
-    """Settle ``radii`` in YADE; returns (centres, radii, figures)."""
-    from yade_electro.yade.runtime import import_yade
-    yade = import_yade()
-    from yade import geom, utils
-    from yade import wrapper as W
-    from yade_electro.yade.spheres import add_spheres
-    O = yade.Omega()
-    O.reset()
-    n = radii.size
-    region, _ = geometry(n, radius)
-    centers = random_placement(radii, region, seed)
-    mat = W.FrictMat(young=MATERIAL["young"], poisson=MATERIAL["poisson"], density=MATERIAL["density"],
-                     frictionAngle=math.atan(MATERIAL["friction"]), label="grains")
-    O.materials.append(mat)
-    ids = add_spheres(centers, radii, mat, O=O)
-    wall_h = region.z_high + 2e-3
-    O.bodies.append(geom.facetCylinder((0, 0, 0.5 * wall_h), radius, wall_h, segmentsNumber=96, wallMask=4,
-                                       material=mat))
-    O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=mat))
-    e = MATERIAL["restitution"]
-    O.engines = [W.ForceResetter(),
-                 W.InsertionSortCollider([W.Bo1_Sphere_Aabb(), W.Bo1_Facet_Aabb(), W.Bo1_Wall_Aabb()]),
-                 W.InteractionLoop([W.Ig2_Sphere_Sphere_ScGeom(), W.Ig2_Facet_Sphere_ScGeom(),
-                                    W.Ig2_Wall_Sphere_ScGeom()],
-                                   [W.Ip2_FrictMat_FrictMat_MindlinPhys(en=W.MatchMaker(algo="val", val=e),
-                                                                       es=W.MatchMaker(algo="val", val=e))],
-                                   [W.Law2_ScGeom_MindlinPhys_Mindlin()]),
-                 W.NewtonIntegrator(gravity=(0, 0, -9.81), damping=0.0)]
-    O.dt = time_step()
-    chunk = max(1, int(round(0.05 / O.dt)))
-    masses = np.array([O.bodies[i].state.mass for i in ids])
-    t0 = time.perf_counter()
-    last = t0
-    ke = float("inf")
-    while O.time < settle_time:
-        O.run(chunk, True)
-        v = np.array([O.bodies[i].state.vel for i in ids])
-        ke = float(0.5 * np.sum(masses * np.sum(v ** 2, axis=1)) / n)
-        now = time.perf_counter()
-        if progress and now - last > progress:
-            last = now
-            print(f"[yade] t = {O.time:.2f} s of at most {settle_time:g} s, kinetic energy {ke:.2e} J per "
-                  f"particle (target {ke_threshold:g}), {now - t0:.0f} s", file=sys.stderr, flush=True)
-        if O.time > 0.1 and ke < ke_threshold:
-            break
-    pos = np.array([tuple(O.bodies[i].state.pos) for i in ids])
-    lost = int(np.sum((pos[:, 2] < -1e-3) | (np.hypot(pos[:, 0], pos[:, 1]) > radius + 1e-3)))
-    figs = {"wall_s": time.perf_counter() - t0, "settled": bool(ke < ke_threshold), "time_s": float(O.time),
-            "ke_per_particle_J": ke, "steps": int(O.iter), "lost": lost}
-    return pos, np.asarray(radii), figs
+def yade_bed(radii, radius, ke_threshold, settle_time, seed=1):
+    """Settle ``radii`` in YADE (:func:`yade_electro.yade.settling.settle_in_cylinder`); returns
+    (centres, radii, figures)."""
+    from yade_electro import liggghts as L
+    from yade_electro.yade.settling import settle_in_cylinder
+    region, _ = geometry(radii.size, radius)
+    bed = settle_in_cylinder(radii, radius, region, L.GranularMaterial(**MATERIAL), time_step(),
+                             settle_time=settle_time, ke_threshold=ke_threshold, seed=seed)
+    figs = {"wall_s": bed.wall_s, "settled": bed.settled, "time_s": bed.time, "ke_per_particle_J": bed.ke_per_particle,
+            "steps": bed.steps, "lost": bed.lost}
+    return bed.centers, bed.radii, figs
 
 
 TABLE = (("n", "spheres", "{:.0f}"), ("bed_height_m", "bed height [mm]", "{:.2f}", 1e3),

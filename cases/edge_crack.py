@@ -75,7 +75,7 @@ def run_crack(n=10000, seed=1, rules=RULES, cache_dir=None):
     measure R_crack for each crack rule; returns a dict of figures. Resets YADE's scene."""
     yade = import_yade()
     from yade_electro.geometry.shapes import Box
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Electrode, Law, Material, Reader
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
@@ -92,10 +92,14 @@ def run_crack(n=10000, seed=1, rules=RULES, cache_dir=None):
         if k:                                     # heal the bonds for the next rule
             for i in bonds:
                 i.phys.cohesionBroken = False
-        engine = ElectricalEngine(RHO_304L, {"top": dict(surface=bar.face("z+"), potential=1.0),
-                                             "bottom": dict(surface=bar.face("z-"), potential=0.0)},
-                                  law="voronoi", law_params=dict(container=bar, crack=rule),
-                                  bond_check="flags", label=f"crack_{rule}")
+        engine = ElectricalEngine(
+            material=Material(resistivity=RHO_304L),
+            boundaries=[
+                Electrode("top", surface=bar.face("z+"), potential=1.0),
+                Electrode("bottom", surface=bar.face("z-"), potential=0.0)],
+            law=Law("voronoi", container=bar, crack=rule),
+            reader=Reader(bond_check="flags"),
+            label=f"crack_{rule}")
         O.engines = O.engines + [engine.runner]
         t1 = time.perf_counter()
         O.step()

@@ -89,7 +89,7 @@ def build(n=2000, seed=1):
 
 def fall(ids, duration=0.35, snapshots=4, out="out/falling_bed", verbose=True):
     """Stage 1: the block falls with the heat engine; returns figures and snapshots."""
-    from yade_electro.yade import HeatEngine
+    from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Material, Output, Reader, walls_from_dict
     from yade_electro.yade.runtime import import_yade
     from yade_electro.post.vtk import write_elements
     O = import_yade().Omega()
@@ -97,9 +97,16 @@ def fall(ids, duration=0.35, snapshots=4, out="out/falling_bed", verbose=True):
     hot = {int(i): T_HOT for i in sph if O.bodies[int(i)].state.pos[0] < 0}
     walls = {"floor": dict(bodies=ids["floor"], temperature=None)}
     walls.update({f"side{k}": dict(bodies=b, temperature=None) for k, b in enumerate(ids["sides"])})
-    e = HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T_COLD, initial_temperature=hot, bonds="contacts",
-                   law="contact", walls=walls, theta="explicit", iterPeriod=PERIOD, label="falling_bed",
-                   history=os.path.join(out, "falling_bed_history.csv"))
+    e = HeatEngine(
+        material=Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        boundaries=walls_from_dict(walls),
+        temperature=InitialTemperature(T_COLD, by_id=hot),
+        law="contact",
+        integrator=Integrator(theta="explicit"),
+        reader=Reader(bonds="contacts"),
+        output=Output(history=os.path.join(out, "falling_bed_history.csv")),
+        iterPeriod=PERIOD,
+        label="falling_bed")
     O.engines = O.engines + [e.runner]
     heat0 = e.coupled.heat_content()
     steps = int(duration / O.dt)
@@ -165,10 +172,16 @@ def press_lid(ids, verbose=True):
 
 def conductivity(ids, lid):
     """Stage 2: steady temperatures between the plate (T_HOT) and the lid (T_COLD)."""
-    from yade_electro.yade import HeatEngine
-    e = HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, 0.5 * (T_HOT + T_COLD), bonds="contacts", law="contact",
-                   walls={"floor": dict(bodies=ids["floor"], temperature=T_HOT),
-                          "lid": dict(bodies=lid, temperature=T_COLD)}, label="falling_bed_k")
+    from yade_electro.yade import HeatEngine, Material, Reader, Wall
+    e = HeatEngine(
+        material=Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        boundaries=[
+            Wall("floor", bodies=ids["floor"], temperature=T_HOT),
+            Wall("lid", bodies=lid, temperature=T_COLD)],
+        temperature=0.5 * (T_HOT + T_COLD),
+        law="contact",
+        reader=Reader(bonds="contacts"),
+        label="falling_bed_k")
     row = e.steady_state()
     g = e.reader.graph
     T = e.temperature

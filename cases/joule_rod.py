@@ -116,7 +116,7 @@ def run_joule(n=5000, seed=1, law="voronoi", theta="backward-euler", thermal_dt=
     time series is under ``'series'`` (time [s], T_mean, T_core, T_theory [K]). Resets YADE."""
     yade = import_yade()
     from yade import pack
-    from yade_electro.yade import ElectroThermalEngine
+    from yade_electro.yade import ElectroThermalEngine, Electrode, Integrator, Law, Material, Output
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
@@ -132,10 +132,16 @@ def run_joule(n=5000, seed=1, law="voronoi", theta="backward-euler", thermal_dt=
     law_params = {"container": shape} if law == "voronoi" else None
     t0 = time.perf_counter()
     engine = ElectroThermalEngine(
-        rod.RHO_304L, {"top": dict(select=ids[top], potential=voltage),
-                       "bottom": dict(select=ids[bottom], potential=0.0)},
-        DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T0, eta=1.0, theta=theta, thermal_dt=thermal_dt,
-        law=law, law_params=law_params, iterPeriod=1, history=history, label="joule_rod")
+        material=Material(resistivity=rod.RHO_304L, density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        boundaries=[
+            Electrode("top", select=ids[top], potential=voltage),
+            Electrode("bottom", select=ids[bottom], potential=0.0)],
+        temperature=T0,
+        law=Law(law, **(law_params or {})),
+        integrator=Integrator(theta=theta, dt=thermal_dt, eta=1.0),
+        output=Output(history=history),
+        iterPeriod=1,
+        label="joule_rod")
     O.engines = O.engines + [engine.runner]
     O.run(int(n_calls), True)
     t_run = time.perf_counter() - t0

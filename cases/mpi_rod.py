@@ -41,10 +41,16 @@ from yade_electro.yade.runtime import import_yade  # noqa: E402
 
 
 def _solve(spec, law, solver, label):
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Material, electrodes_from_dict
     yade = import_yade()
     O = yade.Omega()
-    engine = ElectricalEngine(RHO_304L, spec, law=law, solver=solver, iterPeriod=1, label=label)
+    engine = ElectricalEngine(
+        material=Material(resistivity=RHO_304L),
+        boundaries=electrodes_from_dict(spec),
+        law=law,
+        solver=solver,
+        iterPeriod=1,
+        label=label)
     O.engines = O.engines + [engine.runner]
     t = time.perf_counter()
     O.step()

@@ -231,7 +231,7 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     engine, and return the DEM figures. Resets YADE's scene first."""
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()
-    from yade_electro.yade import ElectroThermalEngine
+    from yade_electro.yade import ElectroThermalEngine, Integrator, Law, Material, Output, electrodes_from_dict
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
@@ -253,11 +253,15 @@ def run_notched(n=5000, seed=1, law="continuum", voltage=VOLTAGE, t_end=T_END, n
     else:
         electrodes = {"end1": dict(select=ids[end1], potential=voltage), "end0": dict(select=ids[end0], potential=0.0)}
     engine = ElectroThermalEngine(
-        RHO_E, electrodes,
-        density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY, temperature=T0,
-        beta=0.0, eta=1.0, theta="backward-euler", thermal_dt=t_end / nsteps, law=law,
-        law_params=law_params, solver=solver, iterPeriod=1,
-        history=history, label="notched")
+        material=Material(resistivity=RHO_E, density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY, beta=0.0),
+        boundaries=electrodes_from_dict(electrodes),
+        temperature=T0,
+        law=Law(law, **(law_params or {})),
+        integrator=Integrator(theta="backward-euler", dt=t_end / nsteps, eta=1.0),
+        output=Output(history=history),
+        solver=solver,
+        iterPeriod=1,
+        label="notched")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
     O.run(int(nsteps), True)

@@ -308,7 +308,7 @@ def run_pin(n=5000, seed=1, laws=LAWS, rate_factor=1.0, every=100, theta_max=0.1
             out_dir="out/pin_torsion", vtk=True, cache_dir=None, progress=print):
     """Twist the pin with the electrical engines running; returns the figures (see the module
     doc) and writes the outputs. Resets YADE's scene."""
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Law, Material, Output, Reader, electrodes_from_dict
     cal = calibration or load_calibration(n, seed, out_dir, cache_dir=cache_dir, progress=progress)
     rate = paper_rate() * rate_factor
     pin = build_pin(n, seed, cal["young"], cal["strength"], rate=rate, ramp_time=2 * RAMP_ANGLE / rate,
@@ -321,9 +321,14 @@ def run_pin(n=5000, seed=1, laws=LAWS, rate_factor=1.0, every=100, theta_max=0.1
     engines = {}
     for law in laws:
         electrodes, params = pin_electrodes(pin, law)
-        engines[law] = ElectricalEngine(RESISTIVITY, electrodes, law=law, law_params=params, container=cyl,
-                                        iterPeriod=every, bond_check="flags", write_back=None,
-                                        label=f"pin_{law}", history=os.path.join(out_dir, f"{tag}_{law}.csv"))
+        engines[law] = ElectricalEngine(
+            material=Material(resistivity=RESISTIVITY),
+            boundaries=electrodes_from_dict(electrodes),
+            law=Law(law, **{**(params or {}), "container": cyl}),
+            reader=Reader(bond_check="flags"),
+            output=Output(write_back=None, history=os.path.join(out_dir, f"{tag}_{law}.csv")),
+            iterPeriod=every,
+            label=f"pin_{law}")
     rows = []
     first = engines[laws[0]]
     state = {}

@@ -199,7 +199,7 @@ def run_plate(n=5000, seed=1, law="continuum", voltage=1.0, gap=0.1, fit_radius=
     YADE's scene first."""
     from yade_electro.yade.runtime import import_yade
     yade = import_yade()
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Law, Material, electrodes_from_dict
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
@@ -219,8 +219,13 @@ def run_plate(n=5000, seed=1, law="continuum", voltage=1.0, gap=0.1, fit_radius=
                       "ground": dict(surface=P.Box((0, 0, 0), (WIDTH, HEIGHT, THICKNESS)).face("y-"), potential=0.0)}
     else:
         electrodes = {"source": dict(select=ids[source], potential=voltage), "ground": dict(select=ids[ground], potential=0.0)}
-    engine = ElectricalEngine(RHO_304L, electrodes, law=law, law_params=law_params, solver=solver, iterPeriod=1,
-                              label="plate")
+    engine = ElectricalEngine(
+        material=Material(resistivity=RHO_304L),
+        boundaries=electrodes_from_dict(electrodes),
+        law=Law(law, **(law_params or {})),
+        solver=solver,
+        iterPeriod=1,
+        label="plate")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
     O.step()

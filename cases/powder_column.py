@@ -133,7 +133,7 @@ def run(n=10, forces=FORCES, progress=print):
     yade = import_yade()
     from yade import utils
     from yade import wrapper as W
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Electrode, Law, Material, Output, Reader
     O = yade.Omega()
     O.reset()
     mat = O.materials.append(W.FrictMat(young=YOUNG, poisson=POISSON, density=DENSITY, frictionAngle=0.3))
@@ -149,15 +149,25 @@ def run(n=10, forces=FORCES, progress=print):
                  W.NewtonIntegrator(damping=0.7)]
     O.dt = 0.3 * utils.PWaveTimeStep()
     O.step()
-    engines = {m: ElectricalEngine(RESISTIVITY, {"top": dict(select=[ids[-1]], potential=1.0),
-                                                 "bottom": dict(select=[ids[0]], potential=0.0)},
-                                   law="contact", law_params=dict(radius=m), bonds="contacts", iterPeriod=10 ** 9,
-                                   geometry_every=1, move_tolerance=1e-12, write_back=None, label=f"column_{m}")
+    engines = {m: ElectricalEngine(
+        material=Material(resistivity=RESISTIVITY),
+        boundaries=[
+            Electrode("top", select=[ids[-1]], potential=1.0),
+            Electrode("bottom", select=[ids[0]], potential=0.0)],
+        law=Law("contact", radius=m),
+        reader=Reader(bonds="contacts", geometry_every=1, move_tolerance=1e-12),
+        output=Output(write_back=None),
+        iterPeriod=10 ** 9,
+        label=f"column_{m}")
                for m in MODELS}
-    engines["plate"] = ElectricalEngine(RESISTIVITY, {"top": dict(select=[ids[-1]], potential=1.0),
-                                                      "plate": dict(wall=plate, potential=0.0)},
-                                        law="contact", law_params=dict(radius="hertz"), bonds="contacts",
-                                        iterPeriod=10 ** 9, write_back=None, label="column_plate")
+    engines["plate"] = ElectricalEngine(
+        material=Material(resistivity=RESISTIVITY),
+        boundaries=[Electrode("top", select=[ids[-1]], potential=1.0), Electrode("plate", wall=plate, potential=0.0)],
+        law=Law("contact", radius="hertz"),
+        reader=Reader(bonds="contacts"),
+        output=Output(write_back=None),
+        iterPeriod=10 ** 9,
+        label="column_plate")
     rows = []
     for F in forces:
         fn, steps = press(O, ids, F)
@@ -343,7 +353,7 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
     """The random packing pressed between plate and lid; returns the figures."""
     from yade_electro.yade.runtime import import_yade
     O = import_yade().Omega()
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Electrode, Law, Material, Output, Reader
     t0 = time.time()
     ids = build_random(n, seed, progress=progress)
     engine = None
@@ -352,11 +362,16 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
     def measure():
         nonlocal engine
         if engine is None:            # made once the bed carries the lid: its contacts exist
-            engine = ElectricalEngine(RESISTIVITY, {"lid": dict(wall=ids["lid"], potential=1.0),
-                                                    "plate": dict(wall=ids["plate"], potential=0.0)},
-                                      law="contact", law_params=dict(radius="hertz"), bonds="contacts",
-                                      iterPeriod=10 ** 9, geometry_every=1, move_tolerance=1e-12, write_back=None,
-                                      label="random_column")
+            engine = ElectricalEngine(
+                material=Material(resistivity=RESISTIVITY),
+                boundaries=[
+                    Electrode("lid", wall=ids["lid"], potential=1.0),
+                    Electrode("plate", wall=ids["plate"], potential=0.0)],
+                law=Law("contact", radius="hertz"),
+                reader=Reader(bonds="contacts", geometry_every=1, move_tolerance=1e-12),
+                output=Output(write_back=None),
+                iterPeriod=10 ** 9,
+                label="random_column")
         engine.step()
         return float(engine.equivalent_resistance)
 

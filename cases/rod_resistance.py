@@ -110,7 +110,7 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
     if electrodes == "surface" and law != "voronoi":
         raise ValueError("surface electrodes need the 'voronoi' law (its cells give the end faces): --law voronoi")
     yade = import_yade()
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Law, Material, Output, electrodes_from_dict
     from yade_electro.yade import packing as P
 
     O = yade.Omega()
@@ -129,8 +129,14 @@ def run_rod(n=5000, seed=1, rho=RHO_304L, voltage=1.0, law="continuum", law_para
                 "bottom": dict(surface=rod.face("bottom"), potential=0.0)}
     else:
         spec = {"top": dict(select=ids[top], potential=voltage), "bottom": dict(select=ids[bottom], potential=0.0)}
-    engine = ElectricalEngine(rho, spec, law=law, law_params=law_params, solver=solver, iterPeriod=1,
-                              history=history, label="rod")
+    engine = ElectricalEngine(
+        material=Material(resistivity=rho),
+        boundaries=electrodes_from_dict(spec),
+        law=Law(law, **(law_params or {})),
+        output=Output(history=history),
+        solver=solver,
+        iterPeriod=1,
+        label="rod")
     O.engines = O.engines + [engine.runner]
     t1 = time.perf_counter()
     O.step()

@@ -16,7 +16,7 @@ Set-up
   (x < 0) starts at ``T_HOT``, the right half at ``T_COLD``, and the drum starts turning.
   Mechanics: FrictMat with E = 1e7 Pa (softened for the time step, as DEM drums are), friction
   0.5, Cundall damping 0.1.
-* Heat: ``HeatEngine(bonds='contacts', law='contact')`` (H = 2 k a, the geometric contact
+* Heat: ``HeatEngine(material=Material(), law='contact', reader=Reader(bonds='contacts'))`` (H = 2 k a, the geometric contact
   radius of the overlap, no softened-stiffness correction: paper 002 uses the overlaps as
   they come) every 10 steps on the elapsed time, explicit (forward Euler, sub-cycled if the
   step ever exceeds the stable one C_i / sum G; with these small contacts the 3e-4 s thermal
@@ -152,15 +152,22 @@ def start_rotation(ids, rpm):
 def heat_engine(ids, hot, label="drum_heat", iterPeriod=ENGINE_PERIOD, history=None, skin=None, overlap=False):
     """The bed's HeatEngine: the left half hot, the shell (and baffles) at T_WALL, the ends
     adiabatic (``overlap``: the engine's ``overlap=``)."""
-    from yade_electro.yade import HeatEngine
-    walls = {"shell": dict(bodies=ids["shell"], temperature=T_WALL),
-             "ends_minus": dict(bodies=ids["ends"][0], temperature=None),
-             "ends_plus": dict(bodies=ids["ends"][1], temperature=None)}
+    from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Material, Output, Reader, Wall
+    walls = [Wall("shell", bodies=ids["shell"], temperature=T_WALL),
+             Wall("ends_minus", bodies=ids["ends"][0], temperature=None),
+             Wall("ends_plus", bodies=ids["ends"][1], temperature=None)]
     if ids["baffles"]:
-        walls["baffles"] = dict(bodies=ids["baffles"], temperature=T_WALL)
-    return HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T_COLD, initial_temperature={int(i): T_HOT for i in hot},
-                      bonds="contacts", law="contact", walls=walls, theta="explicit", iterPeriod=iterPeriod,
-                      label=label, history=history, overlap=overlap, **({} if skin is None else {"skin": skin}))
+        walls.append(Wall("baffles", bodies=ids["baffles"], temperature=T_WALL))
+    return HeatEngine(
+        material=Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        boundaries=walls,
+        temperature=InitialTemperature(T_COLD, by_id={int(i): T_HOT for i in hot}),
+        law="contact",
+        integrator=Integrator(theta="explicit"),
+        reader=Reader(bonds="contacts", overlap=overlap, skin="auto" if skin is None else skin),
+        output=Output(history=history),
+        iterPeriod=iterPeriod,
+        label=label)
 
 
 def lacey_index(pos, is_a, cell=8 * PARTICLE_RADIUS, min_count=5) -> float:

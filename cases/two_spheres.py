@@ -92,7 +92,7 @@ def run_law(law, steps_per_tau=200, taus=5.0, theta="crank-nicolson"):
     yade = import_yade()
     from yade import utils
     from yade import wrapper as W
-    from yade_electro.yade import HeatEngine
+    from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Law, Material, Reader
     O = yade.Omega()
     O.reset()
     mat = O.materials.append(W.FrictMat(young=110e9, poisson=0.34, density=DENSITY, frictionAngle=0.3))
@@ -108,9 +108,13 @@ def run_law(law, steps_per_tau=200, taus=5.0, theta="crank-nicolson"):
     O.step()                               # the contact exists before the engine's first call
     tau = decay_time(law)
     dt = tau / steps_per_tau
-    engine = HeatEngine(DENSITY, SPECIFIC_HEAT, CONDUCTIVITY, T_COLD, initial_temperature={ids[0]: T_HOT},
-                        law=law, bonds="contacts", theta=theta, thermal_dt=dt,
-                        coupled_options=dict(volume_fraction=1.0), label=f"two_spheres_{law}")
+    engine = HeatEngine(
+        material=Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=CONDUCTIVITY),
+        temperature=InitialTemperature(T_COLD, by_id={ids[0]: T_HOT}),
+        law=Law(law, volume_fraction=1.0),
+        integrator=Integrator(theta=theta, dt=dt),
+        reader=Reader(bonds="contacts"),
+        label=f"two_spheres_{law}")
     O.engines = O.engines + [engine.runner]
     n = int(round(taus * steps_per_tau))
     t, T1, T2 = [], [], []

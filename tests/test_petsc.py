@@ -153,7 +153,7 @@ def test_mpi_rod_case_on_two_ranks_in_yade(yade_exe):
 MPY_SCRIPT = textwrap.dedent("""
     from yade import mpy as mp
     import numpy as np
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Electrode, Material, Reader
     for i in range(4):
         for j in range(4):
             for k in range(4):
@@ -164,9 +164,14 @@ MPY_SCRIPT = textwrap.dedent("""
         b.subdomain = 1 + int(b.state.pos[0] > 1.5)
     x = np.array([b.state.pos[0] for b in O.bodies])
     ids = np.arange(len(O.bodies))
-    eng = ElectricalEngine(1e-6, {"a": dict(select=ids[x < 0.5], potential=1.0),
-                                  "b": dict(select=ids[x > 2.5], potential=0.0)},
-                           bonds="contacts", law="contact", iterPeriod=10)
+    eng = ElectricalEngine(
+        material=Material(resistivity=1e-6),
+        boundaries=[
+            Electrode("a", select=ids[x < 0.5], potential=1.0),
+            Electrode("b", select=ids[x > 2.5], potential=0.0)],
+        law="contact",
+        reader=Reader(bonds="contacts"),
+        iterPeriod=10)
     O.engines = O.engines + [eng.runner]
     mp.mpirun(20, 3, withMerge=True)
 """)

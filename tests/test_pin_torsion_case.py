@@ -67,7 +67,7 @@ import numpy as np
 from yade_electro.yade.runtime import import_yade
 yade = import_yade()
 from yade_electro.geometry.shapes import Cylinder
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Law, Material, Output, Reader, electrodes_from_dict
 from yade_electro.yade import packing as P
 O = yade.Omega()
 R, L = 1e-3, 5e-3
@@ -80,13 +80,24 @@ def electrodes():
     return {"top": dict(surface=cyl.face("top"), potential=1.0), "bottom": dict(surface=cyl.face("bottom"), potential=0.0)}
 
 def engines(tag, reference=None):
-    v = ElectricalEngine(0.11e-6, electrodes(), law="voronoi", container=cyl, bond_check="flags", write_back=None,
-                         law_params=dict(container=cyl, crack="facets", reference=reference), label="v_" + tag)
+    v = ElectricalEngine(
+        material=Material(resistivity=0.11e-6),
+        boundaries=electrodes_from_dict(electrodes()),
+        law=Law("voronoi", container=cyl, crack="facets", reference=reference),
+        reader=Reader(bond_check="flags"),
+        output=Output(write_back=None),
+        label="v_" + tag)
     z = np.array([b.state.pos[2] for b in O.bodies]); r = np.array([b.shape.radius for b in O.bodies])
     ids = np.arange(len(O.bodies))
-    c = ElectricalEngine(0.11e-6, {"top": dict(select=ids[L - z - r <= 0.1 * r.mean()].tolist(), potential=1.0),
-                                   "bottom": dict(select=ids[z - r <= 0.1 * r.mean()].tolist(), potential=0.0)},
-                         law="continuum", bond_check="flags", write_back=None, label="c_" + tag)
+    c = ElectricalEngine(
+        material=Material(resistivity=0.11e-6),
+        boundaries=[
+            Electrode("top", select=ids[L - z - r <= 0.1 * r.mean()].tolist(), potential=1.0),
+            Electrode("bottom", select=ids[z - r <= 0.1 * r.mean()].tolist(), potential=0.0)],
+        law="continuum",
+        reader=Reader(bond_check="flags"),
+        output=Output(write_back=None),
+        label="c_" + tag)
     return v, c
 
 live = engines("live")

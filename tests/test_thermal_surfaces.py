@@ -16,8 +16,7 @@ from yade_electro.core.errors import BoundaryConditionError, ThermalError
 from yade_electro.geometry.shapes import Box, Cylinder, Difference
 from yade_electro.geometry.surfaces import Plane
 from yade_electro.packing import bond_pairs, dense_packing
-from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux
-from yade_electro.network.conditions import HeatSource
+from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
 from yade_electro.geometry.bounded_cells import bounded_cells
 
 R, L = 1e-3, 5e-3

@@ -39,15 +39,20 @@ import json
 from yade_electro.yade.runtime import import_yade
 yade = import_yade()
 from yade import utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Material, Reader
 O = yade.Omega()
 O.bodies.append([utils.sphere((0, 0, 0), 1e-3), utils.sphere((1.9e-3, 0, 0), 1e-3)])
 out = {}
 for name, table in (("unknown_id", {7: 300.0}), ("not_a_number", {0: "hot"}), ("nan", {0: float("nan")}),
                     ("not_a_dict", [300.0])):
     try:
-        HeatEngine(8900, 172, 385, 273.15, initial_temperature=table, law="contact", bonds="contacts",
-                   thermal_dt=1e-3, label="bad_" + name)
+        HeatEngine(
+            material=Material(density=8900, specific_heat=172, conductivity=385),
+            temperature=InitialTemperature(273.15, by_id=table),
+            law="contact",
+            integrator=Integrator(dt=1e-3),
+            reader=Reader(bonds="contacts"),
+            label="bad_" + name)
         out[name] = "accepted"
     except Exception as exc:
         out[name] = type(exc).__name__ + ": " + str(exc)

@@ -47,7 +47,7 @@ BOTTOM = pack.inAlignedBox((-1, -1, -1), (1, 1, zmin + 0.5 * r))
 
 from yade_electro import ContactGraph, equivalent_resistance
 from yade_electro.laws.conductance import conductance
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Material, Output, Reader
 
 
 def independent_graph():
@@ -70,16 +70,16 @@ def core_resistance(g):
 
 
 def make_engine(**kw):
-    e = ElectricalEngine(resistivity=RHO,
-                         electrodes={"top": dict(select=TOP, potential=1.0),
-                                     "bottom": dict(select=BOTTOM, potential=0.0)},
+    e = ElectricalEngine(material=Material(resistivity=RHO),
+                         boundaries=[Electrode("top", select=TOP, potential=1.0),
+                                     Electrode("bottom", select=BOTTOM, potential=0.0)],
                          **kw)
     O.engines = O.engines + [e.runner]
     return e
 '''
 
 RUN_AND_COMPARE = PACKING + r'''
-e = make_engine(iterPeriod=2, history="history.csv", move_tolerance=1e3)
+e = make_engine(iterPeriod=2, output=Output(history="history.csv"), reader=Reader(move_tolerance=1e3))
 O.run(6, True)
 g = e.graph
 ref = independent_graph()
@@ -111,7 +111,7 @@ print(json.dumps(out))
 '''
 
 BREAK_BONDS = PACKING + r'''
-e = make_engine(iterPeriod=1000, move_tolerance=1e3, bond_check="flags")   # every bond every call
+e = make_engine(iterPeriod=1000, reader=Reader(move_tolerance=1e3, bond_check="flags"))   # every bond every call
 e.step()
 out = dict(R0=e.equivalent_resistance, I0=e.electrode_currents["top"], rev0=e.graph.revision, reads0=e.reader.full_reads,
            edges0=e.graph.n_edges)
@@ -152,14 +152,16 @@ print(json.dumps(out))
 NO_SPHERES = r'''
 import json
 from yade import pack, utils
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Material
 O.bodies.append(utils.wall(0, axis=2))
 O.bodies.append(utils.box((0, 0, 1), (1, 1, 1)))
 out = {}
 try:
-    ElectricalEngine(resistivity=1e-6,
-                     electrodes={"a": dict(select=pack.inAlignedBox((-9, -9, -9), (9, 9, 9)), potential=1.0),
-                                 "b": dict(select=[1], potential=0.0)})
+    ElectricalEngine(
+        material=Material(resistivity=1e-6),
+        boundaries=[
+            Electrode("a", select=pack.inAlignedBox((-9, -9, -9), (9, 9, 9)), potential=1.0),
+            Electrode("b", select=[1], potential=0.0)])
 except Exception as exc:
     out["build"] = [type(exc).__name__, str(exc)]
 print(json.dumps(out))
@@ -168,16 +170,17 @@ print(json.dumps(out))
 SELECTS_NOTHING = r'''
 import json
 from yade import pack, utils
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Material
 for k in range(5):
     O.bodies.append(utils.sphere((0, 0, 2e-3 * k), 1e-3))
 out = {}
 try:
     # the scene has spheres already, so the engine checks its electrodes when it is built
-    e = ElectricalEngine(resistivity=1e-6,
-                         electrodes={"top": dict(select=pack.inAlignedBox((-1, -1, 5), (1, 1, 6)), potential=1.0),
-                                     "bottom": dict(select=pack.inAlignedBox((-1, -1, -1), (1, 1, 1e-4)),
-                                                    potential=0.0)})
+    e = ElectricalEngine(
+        material=Material(resistivity=1e-6),
+        boundaries=[
+            Electrode("top", select=pack.inAlignedBox((-1, -1, 5), (1, 1, 6)), potential=1.0),
+            Electrode("bottom", select=pack.inAlignedBox((-1, -1, -1), (1, 1, 1e-4)), potential=0.0)])
     e.step()
 except Exception as exc:
     out["step"] = [type(exc).__name__, [c.__name__ for c in type(exc).__mro__], str(exc)]

@@ -17,7 +17,7 @@ BED = r'''
 import json
 import numpy as np
 from yade import pack, utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import HeatEngine, InitialTemperature, Integrator, Material, Reader, Wall
 mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
 floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
 sp = pack.SpherePack()
@@ -29,8 +29,14 @@ O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall
              NewtonIntegrator(gravity=(0, 0, GRAVITY), damping=0.3)]
 O.dt = 0.5 * utils.PWaveTimeStep()
 hot = {i: 373.15 for i in ids if O.bodies[i].state.pos[2] > 0.015}
-e = HeatEngine(8900, 172, 385, 273.15, initial_temperature=hot, bonds="contacts", law=LAW,
-               walls={"floor": dict(bodies=floor, temperature=WALL_T)}, theta=THETA, iterPeriod=10, overlap=OVERLAP)
+e = HeatEngine(
+    material=Material(density=8900, specific_heat=172, conductivity=385),
+    boundaries=[Wall("floor", bodies=floor, temperature=WALL_T)],
+    temperature=InitialTemperature(273.15, by_id=hot),
+    law=LAW,
+    integrator=Integrator(theta=THETA),
+    reader=Reader(bonds="contacts", overlap=OVERLAP),
+    iterPeriod=10)
 O.engines = O.engines + [e.runner]
 heat_init = e.coupled.summary()["heat_content"]
 rows = []
@@ -111,34 +117,41 @@ def outcome(make):
 BAD = OUTCOME + r'''
 import json
 from yade import pack, utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import ElectricalEngine, HeatEngine, Electrode, Material, Reader, Wall
 mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
 floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
 s = O.bodies.append([utils.sphere((0, 0, 1e-3), 1e-3, material=mat), utils.sphere((0, 0, 3e-3), 1e-3, material=mat)])
 out = {}
+M = Material(density=8900, specific_heat=172, conductivity=385)
+granular, bonded = Reader(bonds="contacts"), Reader(bonds="cohesive")
 cases = {
-    "wall_on_sphere": dict(bonds="contacts", walls={"w": dict(bodies=s[0], temperature=300.0)}),
-    "wall_missing": dict(bonds="contacts", walls={"w": dict(bodies=99, temperature=300.0)}),
-    "wall_bad_key": dict(bonds="contacts", walls={"w": dict(bodies=floor, temp=300.0)}),
-    "contact_law_bonded": dict(bonds="cohesive", law="contact"),
-    "solid_law_granular": dict(bonds="contacts", law="continuum"),
-    "walls_bonded": dict(bonds="cohesive", law="continuum", walls={"w": dict(bodies=floor, temperature=300.0)}),
-    "bad_skin": dict(bonds="contacts", skin=-1.0),
-    "overlap_bonded": dict(bonds="cohesive", law="continuum", overlap=True),
-    "overlap_not_bool": dict(bonds="contacts", overlap="yes"),
+    "wall_on_sphere": lambda: dict(reader=granular, boundaries=[Wall("w", bodies=s[0], temperature=300.0)]),
+    "wall_missing": lambda: dict(reader=granular, boundaries=[Wall("w", bodies=99, temperature=300.0)]),
+    "wall_bad_key": lambda: dict(reader=granular, boundaries=[Wall("w", bodies=floor, temp=300.0)]),
+    "contact_law_bonded": lambda: dict(reader=bonded, law="contact"),
+    "solid_law_granular": lambda: dict(reader=granular, law="continuum"),
+    "walls_bonded": lambda: dict(reader=bonded, law="continuum",
+                                 boundaries=[Wall("w", bodies=floor, temperature=300.0)]),
+    "bad_skin": lambda: dict(reader=Reader(bonds="contacts", skin=-1.0)),
+    "overlap_bonded": lambda: dict(reader=Reader(bonds="cohesive", overlap=True), law="continuum"),
+    "overlap_not_bool": lambda: dict(reader=Reader(bonds="contacts", overlap="yes")),
 }
 for name, kw in cases.items():
-    out[name] = outcome(lambda: HeatEngine(8900, 172, 385, 273.15, label="bad_" + name, **kw))
-from yade_electro.yade import ElectricalEngine
-for name, kw in {"wall_electrode_no_contact": dict(bonds="contacts"),
-                 "wall_electrode_bonded": dict(bonds="cohesive", law="continuum")}.items():
-    out[name] = outcome(lambda: ElectricalEngine(1e-7, {"plate": dict(wall=floor, potential=0.0),
-                                                        "top": dict(select=[s[1]], potential=1.0)},
-                                                 label="bad_" + name, **kw))
-from yade_electro.yade import ElectroThermalEngine
+    out[name] = outcome(lambda: HeatEngine(material=M, temperature=273.15, label="bad_" + name, **kw()))
+for name, reader, law in (("wall_electrode_no_contact", granular, "auto"),
+                          ("wall_electrode_bonded", bonded, "continuum")):
+    out[name] = outcome(lambda: ElectricalEngine(
+        material=Material(resistivity=1e-7),
+        boundaries=[Electrode("plate", wall=floor, potential=0.0), Electrode("top", select=[s[1]], potential=1.0)],
+        reader=reader, law=law, label="bad_" + name))
+from yade_electro.yade import ElectroThermalEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 out["overlap_electrodes"] = outcome(lambda: ElectroThermalEngine(
-    1e-7, {"a": dict(select=[s[0]], potential=0.0), "b": dict(select=[s[1]], potential=1.0)}, 8900, 172, 385, 273.15,
-    bonds="contacts", law="contact", overlap=True, label="bad_overlap_electrodes"))
+    material=Material(resistivity=1e-7, density=8900, specific_heat=172, conductivity=385),
+    boundaries=[Electrode("a", select=[s[0]], potential=0.0), Electrode("b", select=[s[1]], potential=1.0)],
+    temperature=273.15,
+    law="contact",
+    reader=Reader(bonds="contacts", overlap=True),
+    label="bad_overlap_electrodes"))
 print(json.dumps(out))
 '''
 
@@ -148,9 +161,9 @@ def test_bad_granular_setups_are_refused_in_the_script(run_yade_script, tmp_path
     assert "is a Sphere, not a wall" in out["wall_on_sphere"]
     for name in ("overlap_bonded", "overlap_electrodes"):
         assert out[name].startswith("ValueError: overlap=True is for heat-only engines in the granular mode"), name
-    assert out["overlap_not_bool"].startswith("ValueError: overlap must be True or False")
+    assert out["overlap_not_bool"].startswith("ValueError: Reader overlap must be True or False")
     assert "no body 99" in out["wall_missing"]
-    assert "unknown key(s) ['temp']" in out["wall_bad_key"]
+    assert "unexpected keyword argument 'temp'" in out["wall_bad_key"]
     assert out["contact_law_bonded"].startswith("ValueError") and "bonds='contacts'" in out["contact_law_bonded"]
     assert out["solid_law_granular"].startswith("ValueError") and "law='contact'" in out["solid_law_granular"]
     assert "granular mode only" in out["walls_bonded"]
@@ -163,7 +176,7 @@ PERIODIC = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
-from yade_electro.yade import ElectricalEngine, HeatEngine
+from yade_electro.yade import ElectricalEngine, HeatEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 n, a, r = 6, 0.004, 0.00201               # a simple-cubic bed, 0.02 mm overlaps, 3 n^3 contacts
 L = n * a
 mat = O.materials.append(FrictMat(young=1.0, poisson=0.3, density=7850, frictionAngle=0.5))
@@ -177,8 +190,14 @@ O.dt = 1e-4
 T0, dT = 300.0, 10.0
 mode = np.cos(2 * math.pi * x0 / L)
 init = {int(i): T0 + dT * c for i, c in zip(ids, mode)}
-eng = HeatEngine(7850, 470, 50, T0, initial_temperature=init, bonds="contacts", law="contact",
-                 theta="backward-euler", iterPeriod=1, time_scale=100.0, label="heat")
+eng = HeatEngine(
+    material=Material(density=7850, specific_heat=470, conductivity=50),
+    temperature=InitialTemperature(T0, by_id=init),
+    law="contact",
+    integrator=Integrator(theta="backward-euler", time_scale=100.0),
+    reader=Reader(bonds="contacts"),
+    iterPeriod=1,
+    label="heat")
 O.engines = O.engines + [eng.runner]
 O.run(1, True)
 out["box_contacts"] = int(np.sum(eng.contact_heat_flow()[1] > 0))
@@ -219,15 +238,27 @@ for k in range(20):
 out["deforming"] = agree
 O.engines = O.engines[:2]
 for name, make in {
-        "electrical_bonded": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:36], potential=1.0),
-                                                             "b": dict(select=ids[-36:], potential=0.0)}, label="e1"),
-        "electrical_contacts": lambda: ElectricalEngine(1e-7, {"a": dict(select=ids[:36], potential=1.0),
-                                                               "b": dict(select=ids[-36:], potential=0.0)},
-                                                        bonds="contacts", law="contact", label="e2"),
-        "heat_bonded": lambda: HeatEngine(7850, 470, 50, T0, label="h1"),
-        "heat_walls": lambda: HeatEngine(7850, 470, 50, T0, bonds="contacts", label="h2",
-                                         walls={"w": dict(bodies=[O.bodies.append(utils.wall(0, axis=2))],
-                                                          temperature=T0)})}.items():
+        "electrical_bonded": lambda: ElectricalEngine(
+            material=Material(resistivity=1e-7),
+            boundaries=[
+                Electrode("a", select=ids[:36], potential=1.0),
+                Electrode("b", select=ids[-36:], potential=0.0)],
+            label="e1"),
+        "electrical_contacts": lambda: ElectricalEngine(
+            material=Material(resistivity=1e-7),
+            boundaries=[
+                Electrode("a", select=ids[:36], potential=1.0),
+                Electrode("b", select=ids[-36:], potential=0.0)],
+            law="contact",
+            reader=Reader(bonds="contacts"),
+            label="e2"),
+        "heat_bonded": lambda: HeatEngine(material=Material(density=7850, specific_heat=470, conductivity=50), temperature=T0, label="h1"),
+        "heat_walls": lambda: HeatEngine(
+            material=Material(density=7850, specific_heat=470, conductivity=50),
+            boundaries=[Wall("w", bodies=[O.bodies.append(utils.wall(0, axis=2))], temperature=T0)],
+            temperature=T0,
+            reader=Reader(bonds="contacts"),
+            label="h2")}.items():
     out[name] = outcome(make)
 print(json.dumps(out))
 """
@@ -255,12 +286,16 @@ def test_periodic_cells_conduct_across_their_faces(run_yade_script, tmp_path):
 CLUMPS = r"""
 import json
 from yade import utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import HeatEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5))
 s = O.bodies.append([utils.sphere((0, 0, 0), 1e-3, material=mat), utils.sphere((1.9e-3, 0, 0), 1e-3, material=mat)])
 O.bodies.appendClumped([utils.sphere((3.8e-3, 0, 0), 1e-3, material=mat),
                         utils.sphere((5.5e-3, 0, 0), 1e-3, material=mat)])
-e = HeatEngine(7850, 470, 50, 300.0, bonds="contacts", label="heat")
+e = HeatEngine(
+    material=Material(density=7850, specific_heat=470, conductivity=50),
+    temperature=300.0,
+    reader=Reader(bonds="contacts"),
+    label="heat")
 print(json.dumps({"nodes": int(e.reader.graph.n_nodes), "clumps": e.reader.ignored["clump"]}))
 """
 
@@ -304,7 +339,7 @@ SAVED_BED = r'''
 import json
 import numpy as np
 from yade import pack, utils
-from yade_electro.yade import HeatEngine, attach
+from yade_electro.yade import HeatEngine, attach, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 def build():
     mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
     floor = O.bodies.append(utils.wall(0, axis=2, sense=1, material=mat))
@@ -317,9 +352,15 @@ def build():
                  NewtonIntegrator(gravity=(0, 0, -9.81), damping=0.3)]
     O.dt = 0.5 * utils.PWaveTimeStep()
     O.run(4000, True)
-    e = HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact", theta="backward-euler",
-                   walls={"floor": dict(bodies=floor, temperature=373.15)}, thermal_dt=1e-3, iterPeriod=10,
-                   history="h.csv")
+    e = HeatEngine(
+        material=Material(density=8900, specific_heat=172, conductivity=385),
+        boundaries=[Wall("floor", bodies=floor, temperature=373.15)],
+        temperature=273.15,
+        law="contact",
+        integrator=Integrator(theta="backward-euler", dt=1e-3),
+        reader=Reader(bonds="contacts"),
+        output=Output(history="h.csv"),
+        iterPeriod=10)
     O.engines = O.engines + [e.runner]
     return e
 def figures(e):
@@ -356,7 +397,8 @@ def test_granular_save_and_load_continues(run_yade_script, tmp_path):
     assert out["heat"] == pytest.approx(out["wall_heat"], rel=1e-9)
 
 
-OVERLAPPED_BED = SAVED_BED.replace('history="h.csv")', 'history="h.csv", overlap=True)')
+assert SAVED_BED.count('reader=Reader(bonds="contacts")') == 1
+OVERLAPPED_BED = SAVED_BED.replace('reader=Reader(bonds="contacts")', 'reader=Reader(bonds="contacts", overlap=True)')
 
 
 def test_overlapped_calls_give_the_same_bed_one_call_later(run_yade_script, tmp_path):
@@ -431,7 +473,7 @@ MATERIALS = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
-from yade_electro.yade import ElectricalEngine, HeatEngine
+from yade_electro.yade import ElectricalEngine, HeatEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 cu = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5, label="cu"))
 steel = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=7850, frictionAngle=0.5, label="steel"))
 r = 2e-3
@@ -440,9 +482,14 @@ b_id = O.bodies.append(utils.sphere((3.8e-3, 0, 0), r, material=steel))
 far = O.bodies.append(utils.sphere((0.1, 0, 0), r, material=steel))       # alone, hot, erased later
 O.dt = 1e-3
 out = {}
-e = HeatEngine(8900, 172, 385, 273.15, initial_temperature={a_id: 373.15, far: 473.15}, bonds="contacts",
-               law="contact", theta="backward-euler", iterPeriod=1, label="heat",
-               materials={"steel": dict(density=7850, specific_heat=470, conductivity=50)})
+e = HeatEngine(
+    material=Materials(default=Material(density=8900, specific_heat=172, conductivity=385), by_yade_material={"steel": Material(density=7850, specific_heat=470, conductivity=50)}),
+    temperature=InitialTemperature(273.15, by_id={a_id: 373.15, far: 473.15}),
+    law="contact",
+    integrator=Integrator(theta="backward-euler"),
+    reader=Reader(bonds="contacts"),
+    iterPeriod=1,
+    label="heat")
 O.engines = [e.runner]
 O.run(50, True)
 O.bodies.erase(far)
@@ -457,16 +504,21 @@ out["heat"] = dict(D=T[a_id] - T[b_id], D_exact=100.0 * (1 + 1e-3 * H * (1 / C1 
                    sum=C1 * T[a_id] + C2 * T[b_id], sum0=C1 * 373.15 + C2 * 273.15, steps=steps,
                    particle_heat=e.history.rows[-1]["particle_heat"], far_heat=-C2 * 200.0)
 O.engines = []
-el = ElectricalEngine(1e-6, {"a": dict(select=[a_id], potential=1.0), "b": dict(select=[b_id], potential=0.0)},
-                      bonds="contacts", law="contact", label="el", materials={"steel": dict(resistivity=5e-6)})
+el = ElectricalEngine(
+    material=Materials(default=Material(resistivity=1e-6), by_yade_material={"steel": Material(resistivity=5e-6)}),
+    boundaries=[Electrode("a", select=[a_id], potential=1.0), Electrode("b", select=[b_id], potential=0.0)],
+    law="contact",
+    reader=Reader(bonds="contacts"),
+    label="el")
 el.step()
 out["R"] = [el.model.equivalent_resistance, 0.5 * (1e-6 + 5e-6) / (2 * a)]
-bad = {"label": {"glass": dict(conductivity=1.0)}, "index": {7: dict(conductivity=1.0)},
-       "property": {"cu": dict(emissivity=0.5)}, "negative": {"cu": dict(conductivity=-1.0)},
-       "resistivity_heat_only": {"cu": dict(resistivity=1e-6)}, "not_a_dict": ["cu"]}
+bad = {"label": lambda: {"glass": Material(conductivity=1.0)}, "index": lambda: {7: Material(conductivity=1.0)},
+       "property": lambda: {"cu": Material(emissivity=0.5)}, "negative": lambda: {"cu": Material(conductivity=-1.0)},
+       "resistivity_heat_only": lambda: {"cu": Material(resistivity=1e-6)}, "not_a_dict": lambda: ["cu"]}
+M = Material(density=8900, specific_heat=172, conductivity=385)
 for name, m in bad.items():
-    out[name] = outcome(lambda: HeatEngine(8900, 172, 385, 273.15, bonds="contacts", law="contact",
-                                           label="bad_" + name, materials=m))
+    out[name] = outcome(lambda: HeatEngine(material=Materials(default=M, by_yade_material=m()), temperature=273.15,
+                                           reader=Reader(bonds="contacts"), law="contact", label="bad_" + name))
 print(json.dumps(out))
 """
 
@@ -484,11 +536,11 @@ def test_particles_of_two_materials(run_yade_script, tmp_path):
     assert out["R"][0] == pytest.approx(out["R"][1], rel=1e-12)
     assert "no material labelled 'glass'" in out["label"] and "['cu', 'steel']" in out["label"]
     assert "no material 7 in O.materials" in out["index"]
-    assert "unknown property ['emissivity']" in out["property"]
-    assert "must be > 0" in out["negative"]
-    assert "unknown property ['resistivity']" in out["resistivity_heat_only"]
+    assert out["property"].startswith("TypeError") and "'emissivity'" in out["property"]   # no such property
+    assert "conductivity must be finite and > 0" in out["negative"]
+    assert "HeatEngine takes no ['resistivity']" in out["resistivity_heat_only"]
     assert "must be a dict" in out["not_a_dict"]
-    for key in ("label", "index", "property", "negative", "resistivity_heat_only", "not_a_dict"):
+    for key in ("label", "index", "negative", "resistivity_heat_only", "not_a_dict"):
         assert out[key].startswith("MaterialError"), out[key]
 
 
@@ -496,7 +548,7 @@ SAVED_PERIODIC = r'''
 import json, math
 import numpy as np
 from yade import utils
-from yade_electro.yade import HeatEngine, attach
+from yade_electro.yade import HeatEngine, attach, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 def build():
     n, a, r = 5, 0.004, 0.00201
     O.periodic = True
@@ -510,9 +562,14 @@ def build():
     O.engines = [ForceResetter(), NewtonIntegrator(gravity=(0, 0, 0))]
     O.dt = 1e-4
     init = {b: 300.0 + 10.0 * math.cos(2 * math.pi * O.bodies[b].state.pos[0] / (n * a)) for b in ids}
-    e = HeatEngine(8900, 172, 385, 300.0, initial_temperature=init, bonds="contacts", law="contact",
-                   theta="backward-euler", iterPeriod=1, time_scale=100.0, history="h.csv",
-                   materials={"steel": dict(density=7850, specific_heat=470, conductivity=50)})
+    e = HeatEngine(
+        material=Materials(default=Material(density=8900, specific_heat=172, conductivity=385), by_yade_material={"steel": Material(density=7850, specific_heat=470, conductivity=50)}),
+        temperature=InitialTemperature(300.0, by_id=init),
+        law="contact",
+        integrator=Integrator(theta="backward-euler", time_scale=100.0),
+        reader=Reader(bonds="contacts"),
+        output=Output(history="h.csv"),
+        iterPeriod=1)
     O.engines = O.engines + [e.runner]
     return e
 def figures(e):
@@ -524,7 +581,8 @@ def figures(e):
 @pytest.mark.parametrize("overlap", [False, True], ids=["plain", "overlap"])
 def test_periodic_two_material_bed_saves_and_continues(run_yade_script, tmp_path, overlap):
     import numpy as np
-    scene = SAVED_PERIODIC.replace('history="h.csv",', 'history="h.csv", overlap=True,') if overlap else SAVED_PERIODIC
+    scene = SAVED_PERIODIC.replace('reader=Reader(bonds="contacts")', 'reader=Reader(bonds="contacts", overlap=True)') if overlap \
+        else SAVED_PERIODIC
     assert scene.count("overlap=True") == int(overlap)
     ref, out, ta, tb = saved_and_continued(run_yade_script, tmp_path, scene, 100, 100)
     assert out["rows"] == ref["rows"] and out["time"] == pytest.approx(ref["time"], rel=1e-12)
@@ -536,15 +594,21 @@ POURED = OUTCOME + r"""
 import json, math
 import numpy as np
 from yade import utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import HeatEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 mat = O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5))
 r = 2e-3
 a = O.bodies.append(utils.sphere((0, 0, 0), r, material=mat))
 b = O.bodies.append(utils.sphere((3.8e-3, 0, 0), r, material=mat))
 wall = O.bodies.append(utils.wall((0, 0, -1), axis=2, material=mat))
 O.dt = 1e-3
-e = HeatEngine(8900, 172, 385, 300.0, initial_temperature={a: 350.0}, bonds="contacts", law="contact",
-               theta="backward-euler", iterPeriod=1, label="heat")
+e = HeatEngine(
+    material=Material(density=8900, specific_heat=172, conductivity=385),
+    temperature=InitialTemperature(300.0, by_id={a: 350.0}),
+    law="contact",
+    integrator=Integrator(theta="backward-euler"),
+    reader=Reader(bonds="contacts"),
+    iterPeriod=1,
+    label="heat")
 O.engines = [e.runner]
 O.run(20, True)
 c = O.bodies.append(utils.sphere((7.6e-3, 0, 0), r, material=mat))      # poured in, touching b
@@ -585,7 +649,7 @@ COMPRESSED = r"""
 import json
 import numpy as np
 from yade import pack, utils
-from yade_electro.yade import HeatEngine
+from yade_electro.yade import HeatEngine, Electrode, InitialTemperature, Integrator, Material, Materials, Output, Reader, Wall
 O.periodic = True
 L = 0.03
 O.cell.setBox(L, L, L)
@@ -602,9 +666,14 @@ O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
              NewtonIntegrator(damping=0.4)]
 O.dt = 0.5 * utils.PWaveTimeStep()
 hot = {i: 400.0 for i in ids if O.bodies[i].state.pos[0] < L / 2}
-e = HeatEngine(2500, 800, 1.0, 300.0, initial_temperature=hot, bonds="contacts", law="contact",
-               theta="backward-euler", iterPeriod=20, label="heat",
-               materials={"cu": dict(density=8900, specific_heat=385, conductivity=385)})
+e = HeatEngine(
+    material=Materials(default=Material(density=2500, specific_heat=800, conductivity=1.0), by_yade_material={"cu": Material(density=8900, specific_heat=385, conductivity=385)}),
+    temperature=InitialTemperature(300.0, by_id=hot),
+    law="contact",
+    integrator=Integrator(theta="backward-euler"),
+    reader=Reader(bonds="contacts"),
+    iterPeriod=20,
+    label="heat")
 O.engines = O.engines + [e.runner]
 O.run(12000, True)
 e.step()                                  # the graph of the positions as they are now

@@ -9,9 +9,9 @@ ROD = r'''
 import json, sys, os
 import numpy as np
 from yade import pack, utils
-from yade_electro.yade import ElectroThermalEngine, ElectricalEngine, attach
+from yade_electro.yade import ElectroThermalEngine, ElectricalEngine, attach, Electrode, Material, Integrator, Output, Reader
 from yade_electro.yade import packing as P
-from yade_electro.network.transient import FixedTemperature, Convection
+from yade_electro.yade import FixedTemperature, Convection
 L, RAD = 2e-3, 0.5e-3
 shape = pack.inCylinder((0, 0, 0), (0, 0, L), RAD)
 def stretch():
@@ -34,12 +34,14 @@ def build(n=400):
             e.dead = True
     O.engines = O.engines + [PyRunner(command="stretch()", iterPeriod=1, label="stretcher")]
     return ids, top, bottom
-def thermal(top, bottom, **kw):
+def thermal(top, bottom, history=None):
     e = ElectroThermalEngine(
-        resistivity=7.3e-7, electrodes={"top": dict(select=top, potential=0.2), "bottom": dict(select=bottom, potential=0.0)},
-        density=7900.0, specific_heat=500.0, conductivity=16.2, temperature=300.0, beta=1e-3,
-        theta="backward-euler", thermal_dt=2e-4, iterPeriod=5, geometry_every=1, move_tolerance=0.0,
-        convection=[Convection("air", shape, h=50.0, t_inf=300.0)], **kw)
+        material=Material(resistivity=7.3e-7, density=7900.0, specific_heat=500.0, conductivity=16.2, beta=1e-3,
+                          reference_temperature=300.0),
+        boundaries=[Electrode("top", select=top, potential=0.2), Electrode("bottom", select=bottom, potential=0.0),
+                    Convection("air", shape, h=50.0, t_inf=300.0)],
+        temperature=300.0, integrator=Integrator(theta="backward-euler", dt=2e-4),
+        reader=Reader(geometry_every=1, move_tolerance=0.0), output=Output(history=history), iterPeriod=5)
     O.engines = O.engines + [e.runner]
     return e
 def figures(e):
@@ -139,25 +141,35 @@ SEVERAL = r'''
 import json, warnings
 import numpy as np
 from yade import pack
-from yade_electro.yade import ElectricalEngine, ENGINES
+from yade_electro.yade import ElectricalEngine, ENGINES, Electrode, Material, Output, Reader, electrodes_from_dict
 from yade_electro.yade import packing as P
 pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
 ids = np.asarray(P.add_bonded_packing(pk))
 z = pk.centers[:, 2]
 el = lambda v: {"top": dict(select=ids[z > z.max() - 1e-4], potential=v), "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)}
 out = {}
-a = ElectricalEngine(resistivity=1e-6, electrodes=el(1.0), history="a.csv")
-b = ElectricalEngine(resistivity=2e-6, electrodes=el(1.0), history="b.csv", write_back="potential_b")
+a = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict(el(1.0)),
+    output=Output(history="a.csv"))
+b = ElectricalEngine(
+    material=Material(resistivity=2e-6),
+    boundaries=electrodes_from_dict(el(1.0)),
+    output=Output(history="b.csv", write_back="potential_b"))
 out["labels"] = [a.label, b.label]
-for kw, key in ((dict(label="electro", history="c.csv"), "explicit_taken"),
-                (dict(history="a.csv", label="third"), "shared_history")):
+for kw, key in ((dict(label="electro", output=Output(history="c.csv")), "explicit_taken"),
+                (dict(output=Output(history="a.csv"), label="third"), "shared_history")):
     try:
-        ElectricalEngine(resistivity=1e-6, electrodes=el(1.0), **kw)
+        ElectricalEngine(material=Material(resistivity=1e-6), boundaries=electrodes_from_dict(el(1.0)), **kw)
     except Exception as exc:
         out[key] = [type(exc).__name__, str(exc)]
 with warnings.catch_warnings(record=True) as w:
     warnings.simplefilter("always")
-    c = ElectricalEngine(resistivity=3e-6, electrodes=el(1.0), label="third", history="c.csv")
+    c = ElectricalEngine(
+        material=Material(resistivity=3e-6),
+        boundaries=electrodes_from_dict(el(1.0)),
+        output=Output(history="c.csv"),
+        label="third")
     out["shared_attribute_warning"] = [str(x.message) for x in w if "both write" in str(x.message)]
 O.engines = O.engines + [a.runner, b.runner, c.runner]
 O.run(4, True)
@@ -184,25 +196,35 @@ SETUP_ERRORS = r'''
 import json
 import numpy as np
 from yade import pack
-from yade_electro.yade import ElectricalEngine, ElectroThermalEngine
-from yade_electro.network.transient import FixedTemperature, Convection, HeatFlux
+from yade_electro.yade import (ElectricalEngine, ElectroThermalEngine, Electrode, Material, Integrator, Output,
+                               electrodes_from_dict, FixedTemperature, Convection)
 from yade_electro.yade import packing as P
 pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
 ids = np.asarray(P.add_bonded_packing(pk))
 z = pk.centers[:, 2]
 EL = {"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0), "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)}
-TH = dict(density=7900.0, specific_heat=500.0, conductivity=16.0, temperature=300.0)
 nowhere = pack.inAlignedBox((1, 1, 1), (2, 2, 2))
-cases = {   # keyword arguments, made when the case runs (a boundary condition checks itself when made)
-  "density 0": lambda: dict(density=0.0), "density negative": lambda: dict(density=-1.0),
-  "density NaN": lambda: dict(density=float("nan")), "density string": lambda: dict(density="7900"),
-  "conductivity string": lambda: dict(conductivity="x"), "specific_heat 0": lambda: dict(specific_heat=0.0),
-  "theta": lambda: dict(theta="rk4"), "theta number": lambda: dict(theta=2.0),
-  "fixed selects nothing": lambda: dict(fixed=[FixedTemperature("hot", nowhere, 400.0)]),
-  "fixed overlap": lambda: dict(fixed=[FixedTemperature("a", ids[:20], 400.0), FixedTemperature("b", ids[10:30], 300.0)]),
-  "convection bad area": lambda: dict(convection=[Convection("air", ids[:5], h=10.0, t_inf=300.0, area=-1.0)]),
-  "flux not a BC": lambda: dict(flux=["hot"]),
-  "thermal_dt": lambda: dict(thermal_dt=-1.0),
+M = dict(resistivity=1e-6, density=7900.0, specific_heat=500.0, conductivity=16.0)
+def heating(material=None, boundaries=(), integrator=None):
+    return ElectroThermalEngine(material=Material(**{**M, **(material or {})}),
+                                boundaries=electrodes_from_dict(EL) + list(boundaries), temperature=300.0,
+                                integrator=integrator or Integrator())
+cases = {   # made when the case runs (a boundary condition checks itself when made)
+  "density 0": lambda: heating(dict(density=0.0)), "density negative": lambda: heating(dict(density=-1.0)),
+  "density NaN": lambda: heating(dict(density=float("nan"))), "density string": lambda: heating(dict(density="7900")),
+  "conductivity string": lambda: heating(dict(conductivity="x")),
+  "specific_heat 0": lambda: heating(dict(specific_heat=0.0)),
+  "theta": lambda: heating(integrator=Integrator(theta="rk4")),
+  "theta number": lambda: heating(integrator=Integrator(theta=2.0)),
+  "fixed selects nothing": lambda: heating(boundaries=[FixedTemperature("hot", nowhere, 400.0)]),
+  "fixed overlap": lambda: heating(boundaries=[FixedTemperature("a", ids[:20], 400.0),
+                                               FixedTemperature("b", ids[10:30], 300.0)]),
+  "convection bad area": lambda: heating(boundaries=[Convection("air", ids[:5], h=10.0, t_inf=300.0, area=-1.0)]),
+  "flux not a BC": lambda: heating(boundaries=["hot"]),
+  "thermal_dt": lambda: heating(integrator=Integrator(dt=-1.0)),
+  "old keyword": lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL),
+  "positional": lambda: ElectroThermalEngine(1e-6, EL, 7900.0, 500.0, 16.0, 300.0),
+  "electrodes as a dict": lambda: ElectricalEngine(material=Material(resistivity=1e-6), boundaries=EL),
 }
 out = {}
 def record(name, fn):
@@ -211,20 +233,39 @@ def record(name, fn):
         out[name] = None
     except Exception as exc:
         out[name] = [type(exc).__name__, [c.__name__ for c in type(exc).__mro__], str(exc)]
-for name, kw in cases.items():
-    record(name, lambda kw=kw: ElectroThermalEngine(resistivity=1e-6, electrodes=EL, **{**TH, **kw()}))
-record("iterPeriod 0", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, iterPeriod=0))
-record("iterPeriod float", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, iterPeriod=2.5))
-record("label", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, label="my engine"))
-record("write_back read-only", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="id"))
-record("write_back YADE's", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="dynamic"))
-record("write_back not a name", lambda: ElectricalEngine(resistivity=1e-6, electrodes=EL, write_back="a.b"))
-record("selector float", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=3.7, potential=1.0)}))
-record("selector floats", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=[1.5, 2.7], potential=1.0)}))
-record("value string", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=EL["top"]["select"], potential="1V")}))
-record("value NaN", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=EL["top"]["select"], current=float("nan"))}))
-record("resistivity string", lambda: ElectricalEngine(resistivity="1e-6", electrodes=EL))
-record("electrode selects nothing", lambda: ElectricalEngine(resistivity=1e-6, electrodes={**EL, "top": dict(select=nowhere, potential=1.0)}))
+for name, make in cases.items():
+    record(name, make)
+record("iterPeriod 0", lambda: ElectricalEngine(material=Material(resistivity=1e-6), boundaries=electrodes_from_dict(EL), iterPeriod=0))
+record("iterPeriod float", lambda: ElectricalEngine(material=Material(resistivity=1e-6), boundaries=electrodes_from_dict(EL), iterPeriod=2.5))
+record("label", lambda: ElectricalEngine(material=Material(resistivity=1e-6), boundaries=electrodes_from_dict(EL), label="my engine"))
+record("write_back read-only", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict(EL),
+    output=Output(write_back="id")))
+record("write_back YADE's", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict(EL),
+    output=Output(write_back="dynamic")))
+record("write_back not a name", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict(EL),
+    output=Output(write_back="a.b")))
+record("selector float", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict({**EL, "top": dict(select=3.7, potential=1.0)})))
+record("selector floats", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict({**EL, "top": dict(select=[1.5, 2.7], potential=1.0)})))
+record("value string", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict({**EL, "top": dict(select=EL["top"]["select"], potential="1V")})))
+record("value NaN", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict({**EL, "top": dict(select=EL["top"]["select"], current=float("nan"))})))
+record("resistivity string", lambda: ElectricalEngine(material=Material(resistivity="1e-6"), boundaries=electrodes_from_dict(EL)))
+record("electrode selects nothing", lambda: ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=electrodes_from_dict({**EL, "top": dict(select=nowhere, potential=1.0)})))
 print(json.dumps(out))
 '''
 
@@ -237,7 +278,10 @@ EXPECTED = {
     "fixed overlap": ("BoundaryConditionError", "fixed-temperature boundary conditions 'a' and 'b'"),
     "convection bad area": ("BoundaryConditionError", "convection boundary condition 'air': areas must be finite"),
     "flux not a BC": ("TypeError", "HeatFlux"),
-    "thermal_dt": ("ValueError", "thermal_dt must be > 0"),
+    "thermal_dt": ("ValueError", "dt must be > 0"),
+    "old keyword": ("TypeError", "resistivity -> material=Material(resistivity=...); electrodes -> boundaries=["),
+    "positional": ("TypeError", "keyword arguments only"),
+    "electrodes as a dict": ("BoundaryConditionError", "boundaries= is a list"),
     "iterPeriod 0": ("ValueError", "iterPeriod must be an integer >= 1"),
     "iterPeriod float": ("ValueError", "iterPeriod must be an integer >= 1"),
     "label": ("ValueError", "label must be a Python identifier"),
@@ -268,15 +312,18 @@ DETECTION = r'''
 import json
 import numpy as np
 from yade import pack
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Material, Output, Reader, electrodes_from_dict
 from yade_electro.yade import packing as P
 pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
 ids = np.asarray(P.add_bonded_packing(pk))
 z = pk.centers[:, 2]
 extra = O.bodies.append(sphere((5e-3, 5e-3, 5e-3), 1e-4))   # an unbonded sphere far away
-e = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
-                                                  "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
-                     geometry_every=0, sweep_calls=4)
+e = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=[
+        Electrode("top", select=ids[z > z.max() - 1e-4], potential=1.0),
+        Electrode("bottom", select=ids[z < z.min() + 1e-4], potential=0.0)],
+    reader=Reader(geometry_every=0, sweep_calls=4))
 out = {"mode": e.reader.bond_mode}
 e.step(); out["reads0"] = e.reader.full_reads
 e.step(); out["reads_unchanged"] = e.reader.full_reads
@@ -288,22 +335,37 @@ r0 = e.model.equivalent_resistance
 inner = int(ids[np.argmin(np.abs(z - 1e-3))])
 O.bodies[inner].shape.radius *= 1.3                       # a bonded sphere grows: its bonds conduct more
 e.step()
-fresh = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
-                                                      "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
-                         geometry_every=0, law=e.model.law_name, label="fresh")
+fresh = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=[
+        Electrode("top", select=ids[z > z.max() - 1e-4], potential=1.0),
+        Electrode("bottom", select=ids[z < z.min() + 1e-4], potential=0.0)],
+    law=e.model.law_name,
+    reader=Reader(geometry_every=0),
+    label="fresh")
 fresh.step()
 out["grown"] = [r0, e.model.equivalent_resistance, fresh.model.equivalent_resistance]
 # the continuum law's transmission surfaces go as r^2 (the voronoi law's faces do not see radii)
-cont = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
-                                                     "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
-                        geometry_every=0, law="continuum", label="cont")
+cont = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=[
+        Electrode("top", select=ids[z > z.max() - 1e-4], potential=1.0),
+        Electrode("bottom", select=ids[z < z.min() + 1e-4], potential=0.0)],
+    law="continuum",
+    reader=Reader(geometry_every=0),
+    label="cont")
 cont.step()
 r1 = cont.model.equivalent_resistance
 O.bodies[inner].shape.radius *= 1.3
 cont.step()
-fresh2 = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
-                                                       "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)},
-                          geometry_every=0, law="continuum", label="fresh2")
+fresh2 = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=[
+        Electrode("top", select=ids[z > z.max() - 1e-4], potential=1.0),
+        Electrode("bottom", select=ids[z < z.min() + 1e-4], potential=0.0)],
+    law="continuum",
+    reader=Reader(geometry_every=0),
+    label="fresh2")
 fresh2.step()
 out["grown_continuum"] = [r1, cont.model.equivalent_resistance, fresh2.model.equivalent_resistance]
 for lab in ("fresh", "cont", "fresh2"):
@@ -346,7 +408,7 @@ PORTS = r'''
 import json, os
 import numpy as np
 from yade import pack
-from yade_electro.yade import ElectricalEngine
+from yade_electro.yade import ElectricalEngine, Electrode, Material, Output, Reader, electrodes_from_dict
 from yade_electro.yade import packing as P
 
 def listening():
@@ -368,8 +430,11 @@ def listening():
 pk = P.dense_packing(pack.inCylinder((0, 0, 0), (0, 0, 2e-3), 0.5e-3), n=300, seed=2)
 ids = np.asarray(P.add_bonded_packing(pk))
 z = pk.centers[:, 2]
-e = ElectricalEngine(resistivity=1e-6, electrodes={"top": dict(select=ids[z > z.max() - 1e-4], potential=1.0),
-                                                  "bottom": dict(select=ids[z < z.min() + 1e-4], potential=0.0)})
+e = ElectricalEngine(
+    material=Material(resistivity=1e-6),
+    boundaries=[
+        Electrode("top", select=ids[z > z.max() - 1e-4], potential=1.0),
+        Electrode("bottom", select=ids[z < z.min() + 1e-4], potential=0.0)])
 seen = []
 O.engines = O.engines + [e.runner, PyRunner(command="seen.append(listening())", iterPeriod=1)]
 O.run(5, True)

@@ -9,9 +9,10 @@ import pytest
 COMMON = r'''
 import json, math
 import numpy as np
-from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, HeatEngine, attach
+from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, HeatEngine, attach, Electrode, Integrator, Law, Material
 from yade_electro.yade import packing as P
-from yade_electro.network.transient import FixedTemperature, Convection, HeatSource
+from yade_electro.yade import FixedTemperature, Convection
+from yade_electro.yade import HeatSource
 L, RAD = 2e-3, 0.5e-3
 rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
 RHO, LAM = 7.3e-7, 16.2
@@ -25,11 +26,20 @@ def build():
 
 STEADY = COMMON + r'''
 build()
-el = ElectricalEngine(RHO, {"top": dict(surface=rod.face("top"), potential=1.0),
-                            "bottom": dict(surface=rod.face("bottom"), potential=0.0)}, label="el")
-heat = HeatEngine(density=7900.0, specific_heat=500.0, conductivity=LAM, temperature=300.0, steady=True,
-                  fixed=[FixedTemperature("cold", surface=rod.face("bottom"), temperature=300.0),
-                         FixedTemperature("hot", surface=rod.face("top"), temperature=400.0)], label="heat")
+el = ElectricalEngine(
+    material=Material(resistivity=RHO),
+    boundaries=[
+        Electrode("top", surface=rod.face("top"), potential=1.0),
+        Electrode("bottom", surface=rod.face("bottom"), potential=0.0)],
+    label="el")
+heat = HeatEngine(
+    material=Material(density=7900.0, specific_heat=500.0, conductivity=LAM),
+    boundaries=[
+        FixedTemperature("cold", surface=rod.face("bottom"), temperature=300.0),
+        FixedTemperature("hot", surface=rod.face("top"), temperature=400.0)],
+    temperature=300.0,
+    integrator=Integrator(steady=True),
+    label="heat")
 O.engines = O.engines + [el.runner, heat.runner]
 O.run(3, True)
 z = np.array([O.bodies[int(i)].state.pos[2] for i in heat.body_ids])
@@ -41,11 +51,15 @@ out = dict(law=el.model.law.name, heat_law=heat.coupled.network.law.name,
 # Joule heating to a steady state, the end faces held at 300 K: the parabola
 # T = 300 + q z (L - z) / (2 lambda), q = V^2 / (rho L^2)
 V = 0.05
-et = ElectroThermalEngine(RHO, {"top": dict(surface=rod.face("top"), potential=V),
-                                "bottom": dict(surface=rod.face("bottom"), potential=0.0)},
-                          density=7900.0, specific_heat=500.0, conductivity=LAM, temperature=300.0,
-                          fixed=[FixedTemperature("a", surface=rod.face("bottom"), temperature=300.0),
-                                 FixedTemperature("b", surface=rod.face("top"), temperature=300.0)], label="et")
+et = ElectroThermalEngine(
+    material=Material(resistivity=RHO, density=7900.0, specific_heat=500.0, conductivity=LAM),
+    boundaries=[
+        Electrode("top", surface=rod.face("top"), potential=V),
+        Electrode("bottom", surface=rod.face("bottom"), potential=0.0),
+        FixedTemperature("a", surface=rod.face("bottom"), temperature=300.0),
+        FixedTemperature("b", surface=rod.face("top"), temperature=300.0)],
+    temperature=300.0,
+    label="et")
 row = et.steady_state()
 q = V ** 2 / (RHO * L ** 2)
 exact = q * z * (L - z) / (2 * LAM)
@@ -69,18 +83,28 @@ BAD = COMMON + r'''
 build()
 from yade_electro.core.errors import BoundaryConditionError
 out = {}
-from yade_electro.geometry.shapes import Plane
+from yade_electro.geometry.surfaces import Plane
 inside = Plane((0, 0, L / 2), (0, 0, 1), tol=1e-9)
 for name, make in (
-        ("electrode", lambda: ElectricalEngine(RHO, {"a": dict(surface=inside, potential=1.0),
-                                                     "b": dict(surface=rod.face("bottom"), potential=0.0)})),
-        ("convection", lambda: HeatEngine(density=7900.0, specific_heat=500.0, conductivity=LAM, temperature=300.0,
-                                          convection=[Convection("air", surface=inside, h=10.0, t_inf=300.0)])),
-        ("steady", lambda: HeatEngine(density=7900.0, specific_heat=500.0, conductivity=LAM, temperature=300.0,
-                                      sources=[HeatSource("q", density=1e6)]).steady_state()),
-        ("crack", lambda: ElectricalEngine(RHO, {"a": dict(surface=rod.face("top"), potential=1.0),
-                                                 "b": dict(surface=rod.face("bottom"), potential=0.0)},
-                                           law="continuum", law_params=dict(crack="facets")))):
+        ("electrode", lambda: ElectricalEngine(
+            material=Material(resistivity=RHO),
+            boundaries=[
+                Electrode("a", surface=inside, potential=1.0),
+                Electrode("b", surface=rod.face("bottom"), potential=0.0)])),
+        ("convection", lambda: HeatEngine(
+            material=Material(density=7900.0, specific_heat=500.0, conductivity=LAM),
+            boundaries=[Convection("air", surface=inside, h=10.0, t_inf=300.0)],
+            temperature=300.0)),
+        ("steady", lambda: HeatEngine(
+            material=Material(density=7900.0, specific_heat=500.0, conductivity=LAM),
+            boundaries=[HeatSource("q", density=1e6)],
+            temperature=300.0).steady_state()),
+        ("crack", lambda: ElectricalEngine(
+            material=Material(resistivity=RHO),
+            boundaries=[
+                Electrode("a", surface=rod.face("top"), potential=1.0),
+                Electrode("b", surface=rod.face("bottom"), potential=0.0)],
+            law=Law("continuum", crack="facets")))):
     try:
         make()
         out[name] = "no error"

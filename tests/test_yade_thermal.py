@@ -10,8 +10,8 @@ SCENE = r'''
 import json, math
 import numpy as np
 from yade import pack, utils
-from yade_electro.yade import ElectroThermalEngine
-from yade_electro.network.transient import Convection
+from yade_electro.yade import ElectroThermalEngine, Electrode, Integrator, Material, Output
+from yade_electro.yade import Convection
 O.materials.append(CohFrictMat(young=210e9, poisson=0.3, density=7900, normalCohesion=1e8, shearCohesion=1e8,
                                momentRotationLaw=True, label="steel"))
 r = 1e-4
@@ -31,9 +31,13 @@ BOTTOM = pack.inAlignedBox((-1, -1, -1), (1, 1, min(zs) + 0.5 * r))
 '''
 
 HEATING = SCENE + r'''
-e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=VOLTAGE), "bottom": dict(select=BOTTOM, potential=0.0)},
-                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
-                         thermal_dt=1e-3, iterPeriod=1, history="heat.csv", theta=THETA)
+e = ElectroThermalEngine(
+    material=Material(resistivity=0.73e-6, density=7900, specific_heat=500, conductivity=15),
+    boundaries=[Electrode("top", select=TOP, potential=VOLTAGE), Electrode("bottom", select=BOTTOM, potential=0.0)],
+    temperature=293.15,
+    integrator=Integrator(theta=THETA, dt=1e-3),
+    output=Output(history="heat.csv"),
+    iterPeriod=1)
 O.engines = O.engines + [e.runner]
 out = {}
 try:
@@ -103,12 +107,18 @@ def test_non_finite_temperatures_stop_and_keep_the_history(run_yade_script, tmp_
 
 
 BCS = SCENE + r'''
-from yade_electro.network.transient import FixedTemperature, Convection
-e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.05), "bottom": dict(select=BOTTOM, potential=0.0)},
-                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
-                         fixed=[FixedTemperature("cold end", BOTTOM, 293.15)],
-                         convection=[Convection("air", pack.inAlignedBox((-1, -1, -1), (1, 1, 1)), h=1e5, t_inf=293.15)],
-                         thermal_dt=1e-3, iterPeriod=1, history="bcs.csv")
+from yade_electro.yade import FixedTemperature, Convection
+e = ElectroThermalEngine(
+    material=Material(resistivity=0.73e-6, density=7900, specific_heat=500, conductivity=15),
+    boundaries=[
+        Electrode("top", select=TOP, potential=0.05),
+        Electrode("bottom", select=BOTTOM, potential=0.0),
+        FixedTemperature("cold end", BOTTOM, 293.15),
+        Convection("air", pack.inAlignedBox((-1, -1, -1), (1, 1, 1)), h=1e5, t_inf=293.15)],
+    temperature=293.15,
+    integrator=Integrator(dt=1e-3),
+    output=Output(history="bcs.csv"),
+    iterPeriod=1)
 O.engines = O.engines + [e.runner]
 O.run(20, True)
 bottom_T = [b.state.temp for b in O.bodies if BOTTOM(tuple(b.state.pos), 0)]
@@ -131,9 +141,12 @@ def test_boundary_conditions_selected_by_predicates(run_yade_script, tmp_path):
 
 
 STATE_REPLACED = SCENE + r'''
-e = ElectroThermalEngine(0.73e-6, {"top": dict(select=TOP, potential=0.1), "bottom": dict(select=BOTTOM, potential=0.0)},
-                         density=7900, specific_heat=500, conductivity=15, temperature=293.15,
-                         thermal_dt=1e-3, iterPeriod=1)
+e = ElectroThermalEngine(
+    material=Material(resistivity=0.73e-6, density=7900, specific_heat=500, conductivity=15),
+    boundaries=[Electrode("top", select=TOP, potential=0.1), Electrode("bottom", select=BOTTOM, potential=0.0)],
+    temperature=293.15,
+    integrator=Integrator(dt=1e-3),
+    iterPeriod=1)
 import meshio
 early = meshio.read(e.write_vtk("vtk/early")["particles"]).point_data["temperature"]   # before any call
 early = [float(early.min()), float(early.max()), int(early.size)]

@@ -5,13 +5,14 @@ material value (g / rho_e, lambda g).
 from .conductance import (conductance, geometric_factor, conductance_laws, register_conductance_law,
                           make_law, check_law_name, is_contact_law, unregister_conductance_law,
                           contact_radius, edge_lengths, ConductanceLaw, FactorNetwork)
+from .law import Law
 from .transmission import (POLYHEDRON_FACES, POLYHEDRON_ALPHA, POLYHEDRON_FV, polyhedron_alpha,
                            polyhedron_volume_fraction, eccentricity, eccentricity_factor,
                            transmission_surface, edge_transmission_surface, volume_fraction, exposed_area)
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
            "check_law_name", "is_contact_law", "unregister_conductance_law", "contact_radius",
-           "edge_lengths", "ConductanceLaw", "FactorNetwork", "POLYHEDRON_FACES", "POLYHEDRON_ALPHA",
+           "edge_lengths", "ConductanceLaw", "FactorNetwork", "Law", "POLYHEDRON_FACES", "POLYHEDRON_ALPHA",
            "POLYHEDRON_FV", "polyhedron_alpha", "polyhedron_volume_fraction", "eccentricity",
            "eccentricity_factor", "transmission_surface", "edge_transmission_surface", "volume_fraction",
            "exposed_area"]

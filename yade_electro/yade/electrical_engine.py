@@ -41,7 +41,8 @@ from . import registry
 from .granular import check_wall_bodies
 from .scene import write_body_attribute
 
-from .engine_base import EngineBase, electrode_walls, material_table
+from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
+from .options import Output, Reader, electrical_settings
 __all__ = ["ElectricalEngine"]
 
 log = logging.getLogger(__name__)
@@ -53,50 +54,49 @@ class ElectricalEngine(EngineBase):
 
     Parameters
     ----------
-    resistivity : float
-        rho_e [ohm m].
-    materials : dict YADE material -> dict(resistivity=ohm m), optional
-        Elements of several materials: the key is a material of ``O.materials`` (its label,
-        or its index); its spheres take that resistivity, the others ``resistivity``. Looked
-        up again whenever the element set changes. An edge takes the mean of its two ends'.
-    electrodes : dict name -> dict(select=... | surface=... | wall=..., potential=V | current=A)
-        ``select``: an element layer (predicate, ids, mask; paper 000's electrodes).
-        ``surface``: a surface of the container (``container.face('top')``, a ``Plane``, a
-        region): the electrode acts at that surface, through each touching element's half cell.
-        ``wall``: body id(s) of a ``Wall``, ``Box`` or facet mesh of a granular bed
-        (``bonds='contacts'``): each particle touching it conducts through its contact.
-    law : str, optional
-        Conductance law; default ``'voronoi'`` when the container is known, else
-        ``'continuum'`` (paper 000's transmission-surface model).
-    container : Shape or YADE predicate, optional
-        The solid. Default: ``law_params['container']``, else the container of the packing
-        ``add_bonded_packing`` put in the scene.
-    law_params, solver, measure, reselect : see ``yade_electro.physics.electrical.ElectricalModel``
-        (a YADE predicate as ``law_params['container']`` is converted to a shape)
+    material : Material or Materials
+        ``Material(resistivity=...)`` [ohm m]; spheres of several YADE materials:
+        ``Materials(default=Material(...), by_yade_material={label: Material(resistivity=...)})``
+        (an edge takes the mean of its two ends' resistivities).
+    boundaries : list of Electrode
+        The electrodes: ``Electrode(name, surface=... | select=... | wall=..., potential=V |
+        current=A)`` (see :class:`~yade_electro.yade.options.Electrode`).
+    law : str or Law
+        The conductance law (default ``'auto'``: ``'voronoi'`` when the container is known,
+        else ``'continuum'``; ``'contact'`` in a granular bed), with its parameters and
+        container: ``Law('voronoi', container=rod, crack='facets')``.
+    reader : Reader
+        How the scene is read and what counts as a change; ``Reader(bonds='contacts')`` for a
+        granular bed.
+    output : Output
+        History CSV, the body attribute written back, ``yade.plot``, the electrodes of R_eq.
+    solver : str
+        Linear solver (default ``'auto'``; ``'cg'``, ``'cg-deflated'``, ``'cg-amg'``, ``'petsc'``,
+        ``'direct'``; see :mod:`yade_electro.solvers`).
     iterPeriod : int >= 1
         Steps between two calls (the PyRunner's period).
-    history : str, optional
-        CSV path written row by row (iter, time, R_eq, V_/I_ per electrode, power, ...).
-    history_mode : {'w', 'a', 'x'}
-        Replace (saying so), append to, or refuse an existing file.
-    bonds, mask, geometry_every, move_tolerance, full_read_every, bond_check, sweep_calls :
-        see :class:`~yade_electro.yade.scene.SceneReader` (``bonds='cohesive'``, a bonded solid)
-    skin : 'auto' or float
-        ``bonds='contacts'`` (a granular bed): the Verlet skin in smallest radii, adapted to the
-        motion by default (see :class:`~yade_electro.yade.granular.GranularReader`); positions
-        are read at every call.
-    write_back : str or None
-        Body attribute that receives each element's potential [V] (default 'potential');
-        None to skip. YADE's own attributes are refused.
-    plot : bool
-        Also feed ``yade.plot.addData`` with the history row.
     label : str, optional
-        Label of the PyRunner and key in the registry (default 'electro', numbered if taken).
+        Label of the PyRunner and key in the registry (default ``'electro'``, numbered if
+        taken).
+
+    Raises
+    ------
+    TypeError
+        A positional argument, or a keyword of the engines before the option objects (the
+        message names its new place).
+    MaterialError, BoundaryConditionError, GraphError, ValueError
+        Anything wrong in the set-up, found when the engine is built.
     """
 
     DEFAULT_LABEL = "electro"
 
-    def __init__(self, resistivity=None, electrodes=None, law=None, law_params=None, solver="auto",
+    @keyword_only
+    def __init__(self, *, material, boundaries, law="auto", reader: Reader = Reader(), output: Output = Output(),
+                 solver="auto", iterPeriod: int = 1, label: Optional[str] = None):
+        self._setup(**electrical_settings(material, boundaries, law, reader, output), solver=solver,
+                    iterPeriod=iterPeriod, label=label)
+
+    def _setup(self, resistivity=None, electrodes=None, law=None, law_params=None, solver="auto",
                  measure=None, iterPeriod: int = 1, history: Optional[str] = None, history_mode: str = "w",
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,

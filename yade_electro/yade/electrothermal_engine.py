@@ -6,7 +6,6 @@ from __future__ import annotations
 import dataclasses
 import logging
 import warnings
-from concurrent.futures import ThreadPoolExecutor
 from typing import Dict, Optional
 
 import numpy as np
@@ -23,15 +22,17 @@ from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
 from .electrical_engine import ElectricalEngine
-from .engine_base import electrode_walls, material_table, synced_property
-from .overlap import WORKER, OverlapWork, available_cores, overlap_competes
+from .engine_base import electrode_walls, keyword_only, material_table, synced_property
+from .options import Output, Reader, thermal_settings
+from ..physics.integrator import Integrator
+from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
 
 log = logging.getLogger(__name__)
 
 
 @registry.engine_type
-class ElectroThermalEngine(ElectricalEngine):
+class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
     """Joule heating and heat conduction every ``iterPeriod`` steps of a YADE simulation.
 
     Each call reads the graph (only what changed), brings the potential up to date (a solve
@@ -48,61 +49,57 @@ class ElectroThermalEngine(ElectricalEngine):
 
     Parameters
     ----------
-    resistivity, electrodes, law, law_params, solver, measure, iterPeriod, history, bonds,
-    mask, geometry_every, move_tolerance, full_read_every, bond_check, plot, label : see ElectricalEngine
-        ``electrodes=None``: heat conduction only (no resistivity needed).
-    density [kg/m^3], specific_heat [J/(kg K)], conductivity [W/(m K)] : thermal material
-    temperature : initial temperature [K] (of every element, and of elements added later)
-    initial_temperature : dict body id -> K, optional
-        Starting temperatures of chosen elements (the others start at ``temperature``), e.g. a
-        hot and a cold half of a bed. Ignored when the engine resumes a saved run (the
-        temperatures are then the bodies' ``b.state.temp``).
-    beta : rho_e(T) = rho_0 (1 + beta (T - T_0)) [1/K]; 0 for a constant resistivity
-    theta : 'explicit', 'crank-nicolson', 'backward-euler' or a number in [0, 1]
-    fixed, flux, convection : lists of ``yade_electro.network.transient`` FixedTemperature, HeatFlux,
-        Convection; their ``nodes`` may be YADE predicates, body id lists or masks, or give
-        ``surface=`` (a surface of the container, as for electrodes)
-    sources : list of ``yade_electro.network.transient.HeatSource`` (heat generated inside the solid,
-        W or W/m^3, shared by element volume)
-    thermal_dt : float, optional; time_scale : float
-    steady : bool
-        Each call solves the steady temperatures (with the Joule heat, sources and boundary
-        conditions of that moment; the thermal clock does not move) instead of a time step:
-        for a solid, or a bed, whose heat settles faster than it moves. :meth:`steady_state`
-        does the same once, from the script.
-    thermal_solver : linear solver of the implicit heat step ('cg' default)
-    coupled_options : dict, extra keyword arguments of ``ElectroThermalModel``
-    walls : dict name -> dict(bodies=ids, temperature=K or None, conductivity=W/(m K)), optional
-        Walls of a granular bed (``bonds='contacts'``): ``Wall``, ``Box`` or facet-mesh bodies,
-        isothermal at ``temperature`` or adiabatic (None); see ``yade_electro.network.transient.ThermalWall``.
-        Their heat is in the history (``wall_heat:<name>``) and in :meth:`wall_heat`.
-    skin : Verlet skin of the granular mode (see ElectricalEngine)
-    materials : dict YADE material -> dict(density=, specific_heat=, conductivity=, resistivity=), optional
-        Elements of several materials: the key is a material of ``O.materials`` (its label, or
-        its index), the values override the engine's for the spheres of that material (the
-        others keep them). Looked up again whenever the element set changes (a full read).
-        Edges take the harmonic mean of their two conductivities and the mean of their
-        resistivities; a wall contact the harmonic mean of the particle's and the wall's.
-    overlap : bool
-        Heat-only engines in the granular mode (``electrodes=None``, ``bonds='contacts'``):
-        run each call's numpy work (the Verlet lists, the walls' overlaps, the conductances,
-        the heat step and the history row) on a worker thread while YADE steps on, so that a
-        call pauses YADE's loop only to read the scene and write temperatures (default False).
-        The price is a lag of one call: the temperatures a call computes reach ``b.state.temp``
-        (and ``yade.plot``) at the next call. The engine's own results (``temperature``,
-        ``wall_heat``, ``coupled``, ...) and :meth:`sync` wait for the last call and publish
-        it; a scene saved in between holds the unpublished call's input, so a loaded run
-        continues exactly as an uninterrupted one. The history row is written as soon as the
-        call is computed. See the README (*Granular mode*) for when it pays.
+    material : Material or Materials
+        ``Material(density=..., specific_heat=..., conductivity=...)`` [kg/m^3, J/(kg K),
+        W/(m K)], with ``resistivity`` [ohm m] when there are electrodes, and ``beta`` [1/K]
+        with ``reference_temperature`` [K] for rho_e(T) = rho_0 (1 + beta (T - T_0)).
+    boundaries : list
+        :class:`~yade_electro.yade.options.Electrode` (none: heat conduction only),
+        ``FixedTemperature``, ``HeatFlux``, ``Convection`` (on elements ``nodes=`` or at a
+        ``surface=`` of the container), ``HeatSource`` (W or W/m^3, shared by element volume),
+        and in a granular bed :class:`~yade_electro.yade.options.Wall` (isothermal or
+        adiabatic walls; their heat is in the history as ``wall_heat:<name>`` and in
+        :meth:`wall_heat`).
+    temperature : float or InitialTemperature
+        Starting temperature [K] of every element and of elements added later;
+        ``InitialTemperature(K, by_id={id: K})`` gives chosen elements their own.
+    law : str or Law
+        As for :class:`ElectricalEngine`; ``Law(..., volume_fraction=...)`` sets the heat
+        capacities ``rho c V / fv``.
+    integrator : Integrator
+        Time integration (theta, step, steady states, sub-cycling, safety) and the coupling
+        to rho_e(T); see :class:`~yade_electro.physics.integrator.Integrator`.
+    reader : Reader
+        As for :class:`ElectricalEngine`; ``Reader(overlap=True)`` runs a heat-only granular
+        engine's numpy work on a worker thread (results one call later; see :meth:`sync`).
+    output : Output
+        As for :class:`ElectricalEngine`.
+    solver : str
+        Linear solver of the potential (the heat step's is ``Integrator(solver=...)``).
+    iterPeriod : int >= 1
+        Steps between two calls.
+    label : str, optional
+        Default ``'electrothermal'`` (``'heat'`` for :class:`HeatEngine`).
+
+    Raises
+    ------
+    TypeError
+        A positional argument, or an old keyword (the message names its new place).
+    MaterialError, BoundaryConditionError, ThermalError, GraphError, ValueError
+        Anything wrong in the set-up, found when the engine is built.
     """
 
     DEFAULT_LABEL = "electrothermal"
 
-    #: the call computed on the worker thread and not yet published (overlap=True)
-    _inflight = None
-    overlap = False
 
-    def __init__(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
+    @keyword_only
+    def __init__(self, *, material, boundaries=(), temperature, law="auto", integrator: Integrator = Integrator(),
+                 reader: Reader = Reader(), output: Output = Output(), solver="auto", iterPeriod: int = 1,
+                 label: Optional[str] = None):
+        self._setup(**thermal_settings(material, boundaries, temperature, law, integrator, reader, output,
+                                       type(self).__name__), solver=solver, iterPeriod=iterPeriod, label=label)
+
+    def _setup(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
                  temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(),
                  flux=(), convection=(),
                  sources=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
@@ -123,7 +120,7 @@ class ElectroThermalEngine(ElectricalEngine):
         if overlap and _resume is None:
             said = overlap_competes(int((O if O is not None else import_yade().Omega()).numThreads), available_cores())
             if said:
-                warnings.warn(said, stacklevel=3)
+                warnings.warn(said, stacklevel=4)
         self._resumed_work = None
         wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
@@ -218,58 +215,6 @@ class ElectroThermalEngine(ElectricalEngine):
     coupled = synced_property("_coupled", "The engine's ElectroThermalModel (up to date with the last call).")
     reader = synced_property("_reader", "The engine's scene reader (its graph is the last call's).")
     history = synced_property("_history", "The engine's History (with the last call's row).")
-
-    def sync(self) -> Optional[dict]:
-        """With ``overlap=True``: wait for the last call's work on the worker thread and publish
-        it (temperatures to ``b.state.temp``, ``yade.plot``); returns its history row (None
-        when nothing was pending). A worker's error is raised here. Without overlap: nothing."""
-        return self._publish_inflight(save=True)
-
-    def _publish_inflight(self, save: bool) -> Optional[dict]:
-        if self._inflight is None or getattr(WORKER, "active", False):
-            return None
-        future, bodies = self._inflight
-        self._inflight = None
-        try:
-            out, temperatures = future.result()
-        except Exception as exc:
-            self.error = exc
-            log.error("yade-electro engine %r failed in its overlapped call: %s: %s", self.label,
-                      type(exc).__name__, exc)
-            raise
-        self._publish(bodies, out, temperatures)
-        if save:
-            self._save_state()
-        return out
-
-    def _publish(self, bodies, out, temperatures):
-        """An overlapped call's results to YADE: temperatures [K] to ``bodies``, its row to
-        ``yade.plot`` (the worker already wrote it to the history)."""
-        self._temperature_writer.write(bodies, temperatures)
-        if self.plot:
-            self._plot_row(out)
-
-    def _drop_inflight(self):
-        """Wait for a pending overlapped call and discard it (its scene was replaced)."""
-        if self._inflight is not None:
-            future, _ = self._inflight
-            self._inflight = None
-            future.exception()
-
-    def _executor(self) -> ThreadPoolExecutor:
-        if getattr(self, "_pool", None) is None:
-            self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=f"yade-electro-{self.label}")
-        return self._pool
-
-    def remove(self):
-        """Publish a pending overlapped call, then as ``EngineBase.remove``."""
-        try:
-            self.sync()
-        finally:
-            super().remove()
-            if getattr(self, "_pool", None) is not None:
-                self._pool.shutdown(wait=True)
-                self._pool = None
 
     @staticmethod
     def _wall_specs(walls):
@@ -492,47 +437,24 @@ class ElectroThermalEngine(ElectricalEngine):
         out["graph_revision"] = int(graph.revision)
         return out
 
-    def _step_overlapped(self):
-        """One call with ``overlap=True``: publish the previous call, read the scene, save the
-        state (the published one, plus this call's input), hand the rest to the worker."""
-        if self._resumed_work is not None:          # a loaded scene's call that was not published
-            work, self._resumed_work = self._resumed_work, None
-            self._resume_work(work)
-        self._publish_inflight(save=False)         # the state saved below covers it
-        state = self._state_dict()
-        capture, dt = self.reader.capture(), self._call_dt()
-        self._apply_materials()
-        work = OverlapWork(capture, dt, self._pending_temperatures, int(self.O.iter), float(self.O.time))
-        self._pending_temperatures = {}
-        self._last_time = work.mech_time
-        state["pending"] = {}
-        state["overlap_iter"] = work.iteration
-        persistence.save_call(self.O, self.label, tuple(work))
-        self._inflight_state = state
-        self._inflight = (self._executor().submit(self._compute, work), self.reader.bodies)
-        return None             # (_guarded saves the state)
+    @property
+    def critical_time_step(self) -> float:
+        """The explicit scheme's stability bound ``min_i C_i / (sum_j G_ij + h_i A_i)`` [s] on
+        the current graph (inf when no free element exchanges heat). A forward-Euler step longer
+        than ``Integrator.safety`` times it is split into equal sub-steps."""
+        return float(self.coupled.heat.critical_time_step)
 
-    def _compute(self, work: "OverlapWork"):
-        """The worker's part of an overlapped call: (history row, temperatures [K])."""
-        WORKER.active = True
-        try:
-            graph = self.reader.advance(work.capture)
-            row = self._heat_step(graph, work.dt, None, work.pending)
-            out = self._row(work.iteration, work.mech_time, row, graph)
-            self.history.append(out)
-            return out, np.array(self._coupled.temperature, dtype=float)
-        finally:
-            WORKER.active = False
+    @property
+    def allowed_time_step(self) -> float:
+        """The longest (sub-)step the integrator takes [s]: ``safety * critical_time_step /
+        (1 - 2 theta)`` for theta < 1/2, inf otherwise."""
+        return float(self.coupled.heat.allowed_time_step())
 
-    def _resume_work(self, work: "OverlapWork"):
-        """Compute and publish the saved unpublished call of a loaded scene (same spheres)."""
-        if not np.array_equal(work.capture.ids, self.reader.graph.ids):
-            log.warning("engine %r: the spheres changed between the load and the first call; the saved call of "
-                        "iteration %d is not replayed (the next call integrates its interval)", self.label,
-                        work.iteration)
-            return
-        self._publish(self._reader.bodies, *self._compute(work))
-        self._last_time = work.mech_time
+    @property
+    def substeps(self) -> int:
+        """The sub-steps the last call's heat step was split into (1 for an implicit step)."""
+        rows = self.history.rows
+        return int(rows[-1].get("n_substeps", 1)) if rows else 0
 
     @property
     def temperature(self) -> np.ndarray:

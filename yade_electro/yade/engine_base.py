@@ -4,11 +4,13 @@ engine is built."""
 
 from __future__ import annotations
 
+import functools
+import inspect
 import logging
 import os
 import pickle
 import warnings
-from typing import Dict
+from typing import Dict, Optional
 
 import numpy as np
 
@@ -22,9 +24,77 @@ from .runtime import MPY_REFUSAL, import_yade, in_mpy_subdomain
 from .granular import GranularReader
 from .scene import SceneReader, check_write_back, predicate_selector
 
-__all__ = ["EngineBase", "synced_property", "electrode_walls", "material_table", "is_predicate", "check_period"]
+__all__ = ["EngineBase", "synced_property", "electrode_walls", "material_table", "is_predicate", "check_period",
+           "REMOVED_KEYWORDS", "keyword_only"]
 
 log = logging.getLogger(__name__)
+
+
+#: Keywords of the engines before their option objects, and where each went.
+REMOVED_KEYWORDS = {
+    "resistivity": "material=Material(resistivity=...)",
+    "density": "material=Material(density=...)",
+    "specific_heat": "material=Material(specific_heat=...)",
+    "conductivity": "material=Material(conductivity=...)",
+    "beta": "material=Material(beta=..., reference_temperature=...)",
+    "materials": "material=Materials(default=Material(...), by_yade_material={label: Material(...)})",
+    "electrodes": "boundaries=[Electrode('top', surface=... | select=... | wall=..., potential=... | current=...), ...]",
+    "fixed": "boundaries=[FixedTemperature(...), ...]",
+    "flux": "boundaries=[HeatFlux(...), ...]",
+    "convection": "boundaries=[Convection(...), ...]",
+    "sources": "boundaries=[HeatSource(...), ...]",
+    "walls": "boundaries=[Wall('shell', bodies=ids, temperature=K or None), ...]",
+    "initial_temperature": "temperature=InitialTemperature(K, by_id={id: K})",
+    "theta": "integrator=Integrator(theta=...)",
+    "thermal_dt": "integrator=Integrator(dt=...)",
+    "time_scale": "integrator=Integrator(time_scale=...)",
+    "steady": "integrator=Integrator(steady=True)",
+    "thermal_solver": "integrator=Integrator(solver=...)",
+    "eta": "integrator=Integrator(eta=...)",
+    "coupled_options": "integrator=Integrator(coupling_iterations=..., subcycle=..., safety=...) or "
+                       "law=Law(..., volume_fraction=...)",
+    "law_params": "law=Law(name, **params)",
+    "container": "law=Law(name, container=...)",
+    "measure": "output=Output(measure=(a, b))",
+    "history": "output=Output(history='file.csv')",
+    "history_mode": "output=Output(history_mode=...)",
+    "write_back": "output=Output(write_back=...)",
+    "plot": "output=Output(plot=True)",
+    "bonds": "reader=Reader(bonds=...)",
+    "mask": "reader=Reader(mask=...)",
+    "geometry_every": "reader=Reader(geometry_every=...)",
+    "move_tolerance": "reader=Reader(move_tolerance=...)",
+    "full_read_every": "reader=Reader(full_read_every=...)",
+    "bond_check": "reader=Reader(bond_check=...)",
+    "sweep_calls": "reader=Reader(sweep_calls=...)",
+    "skin": "reader=Reader(skin=...)",
+    "reselect": "reader=Reader(reselect=True)",
+    "overlap": "reader=Reader(overlap=True)",
+}
+
+
+def keyword_only(init):
+    """Decorator of an engine's ``__init__``: a positional argument, or a keyword that moved into
+    an option object, raises TypeError in the user's script saying where it went."""
+    params = inspect.signature(init).parameters
+    known = [p for p in params if p != "self"]
+
+    @functools.wraps(init)
+    def wrapper(self, *args, **kwargs):
+        name = type(self).__name__
+        if args:
+            raise TypeError(f"{name} takes keyword arguments only ({', '.join(known)}); e.g. "
+                            f"{name}(material=Material(...), ...). Physics values are never positional.")
+        moved = [k for k in kwargs if k not in params and k in REMOVED_KEYWORDS]
+        if moved:
+            raise TypeError(f"{name}: {', '.join(repr(k) for k in moved)} moved into the engine's option objects: "
+                            + "; ".join(f"{k} -> {REMOVED_KEYWORDS[k]}" for k in moved)
+                            + " (from yade_electro.yade import Material, Electrode, Law, Integrator, Reader, Output)")
+        unknown = [k for k in kwargs if k not in params]
+        if unknown:
+            raise TypeError(f"{name}: unknown keyword(s) {unknown}; it takes {', '.join(known)}")
+        return init(self, **kwargs)
+    return wrapper
 
 
 def is_predicate(obj) -> bool:
@@ -271,7 +341,15 @@ class EngineBase:
         log.warning("engine %r: the scene was replaced (O.load): continuing from the state it saved", self.label)
         kwargs = dict(config["kwargs"])
         registry.ENGINES.pop(self.label, None)
-        type(self).__init__(self, **kwargs, label=self.label, O=self.O, _resume=config)
+        self._setup(**kwargs, label=self.label, O=self.O, _resume=config)
+
+    @classmethod
+    def resumed(cls, config: dict, label: str, O, overrides: Optional[dict] = None):
+        """The engine ``config`` (what :mod:`.persistence` saved) describes, continuing the saved
+        run on scene ``O``; ``overrides`` replace saved settings (internal names)."""
+        engine = cls.__new__(cls)
+        engine._setup(**{**dict(config["kwargs"]), **dict(overrides or {})}, label=label, O=O, _resume=config)
+        return engine
 
     # -- one call ------------------------------------------------------------------------------
     def step(self):

@@ -2,29 +2,44 @@
 
 from __future__ import annotations
 
-import logging
+from typing import Optional
 
-
+from ..core.errors import BoundaryConditionError
+from ..physics.integrator import Integrator
 from . import registry
-
 from .electrothermal_engine import ElectroThermalEngine
-__all__ = ["HeatEngine"]
+from .engine_base import keyword_only
+from .options import Output, Reader, thermal_settings
 
-log = logging.getLogger(__name__)
+__all__ = ["HeatEngine"]
 
 
 @registry.engine_type
 class HeatEngine(ElectroThermalEngine):
-    """Heat conduction only (no electrodes): :class:`ElectroThermalEngine` with
-    ``electrodes=None``, the same boundary conditions (``fixed``, ``flux``, ``convection``,
-    ``sources``; nodes or surfaces), time steps or ``steady=True``. Its default label is
-    'heat'. (Not YADE's own ``ThermalEngine``, which needs a FlowEngine.)"""
+    """Heat conduction only: :class:`ElectroThermalEngine` without electrodes (its default
+    label is ``'heat'``). The same thermal boundaries (``FixedTemperature``, ``HeatFlux``,
+    ``Convection``, ``HeatSource``, on elements or surfaces; ``Wall`` in a granular bed), time
+    steps or ``Integrator(steady=True)``. Not YADE's own ``ThermalEngine``, which needs a
+    FlowEngine.
+
+    Parameters
+    ----------
+    material, boundaries, temperature, law, integrator, reader, output, iterPeriod, label
+        As for :class:`ElectroThermalEngine` (``material`` needs no resistivity).
+
+    Raises
+    ------
+    BoundaryConditionError
+        An ``Electrode`` among the boundaries (use :class:`ElectroThermalEngine`).
+    """
 
     DEFAULT_LABEL = "heat"
 
-    def __init__(self, density=None, specific_heat=None, conductivity=None, temperature=None, **kwargs):
-        if kwargs.get("electrodes") is not None:
-            raise ValueError("HeatEngine conducts heat only: use ElectroThermalEngine for electrodes")
-        kwargs["electrodes"] = None
-        super().__init__(density=density, specific_heat=specific_heat, conductivity=conductivity,
-                         temperature=temperature, **kwargs)
+    @keyword_only
+    def __init__(self, *, material, boundaries=(), temperature, law="auto", integrator: Integrator = Integrator(),
+                 reader: Reader = Reader(), output: Output = Output(), iterPeriod: int = 1,
+                 label: Optional[str] = None):
+        settings = thermal_settings(material, boundaries, temperature, law, integrator, reader, output, "HeatEngine")
+        if settings["electrodes"] is not None:
+            raise BoundaryConditionError("HeatEngine conducts heat only: use ElectroThermalEngine for electrodes")
+        self._setup(**settings, iterPeriod=iterPeriod, label=label)

@@ -1,6 +1,7 @@
 """The packing recipe in one namespace, for YADE scripts: container shapes
 (:mod:`yade_electro.geometry.shapes`), dense placement and statistics (:mod:`yade_electro.packing`)
-and YADE bonding (:mod:`yade_electro.yade.bonding`).
+and YADE bonding (:mod:`yade_electro.yade.bonding`; :func:`bonded_packing` bonds a packing made
+elsewhere, e.g. by YADE's ``pack.randomDensePack``).
 
 ``from yade_electro.yade import packing as P`` then ``P.add_bonded_packing(P.dense_packing(
 pack.inCylinder(...), n=5000))`` is the two-line recipe of paper 000 section 2.1. This module
@@ -11,10 +12,11 @@ from ..geometry.shapes import (Box, Cylinder, Difference, GridShape, Intersectio
 from ..packing import (DEFAULT_DETECTION_FACTOR, PACKING_VERSION, SpherePacking, bond_pairs, dense_packing,
                        detection_factor_for_coordination, mean_radius_for_count, packing_statistics)
 from .bonding import add_bonded_packing, steel_304L
+from .spheres import bonded_packing
 
 __all__ = [
     "Shape", "Cylinder", "Box", "Sphere", "Difference", "Intersection", "Union", "GridShape",
     "as_shape", "container_volume", "mean_radius_for_count", "SpherePacking", "dense_packing",
     "bond_pairs", "detection_factor_for_coordination", "packing_statistics",
-    "add_bonded_packing", "steel_304L", "DEFAULT_DETECTION_FACTOR", "PACKING_VERSION",
+    "add_bonded_packing", "bonded_packing", "steel_304L", "DEFAULT_DETECTION_FACTOR", "PACKING_VERSION",
 ]

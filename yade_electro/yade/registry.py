@@ -131,10 +131,7 @@ def attach(label: Optional[str] = None, O=None, **overrides):
         return old
     if old is not None:
         ENGINES.pop(label, None)
-    kwargs = dict(config["kwargs"])
-    kwargs.update(overrides)
-    cls = engine_class(config["engine"])
-    return cls(**kwargs, label=label, O=O, _resume=config)
+    return engine_class(config["engine"]).resumed(config, label, O, overrides)
 
 
 def run(label: str):
