@@ -26,8 +26,9 @@ lint:
 
 # the docs site (Sphinx, numpydoc), warnings as errors, into docs/_build/html
 docs:
+	rm -rf docs/_api docs/_generated
 	$(PY) docs/generate.py
-	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	$(PY) -m sphinx -E -W --keep-going -q -b html docs docs/_build/html
 
 # rod validation case (paper 000, section 3): both laws side by side
 demo: install

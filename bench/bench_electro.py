@@ -30,7 +30,7 @@ from yade_electro.yade.runtime import import_yade  # noqa: E402
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade import pack
-    from yade_electro.laws.conductance import conductance
+    from yade_electro.laws.factors import conductance
     from yade_electro.network.conduction import ConductionProblem
     from yade_electro.network.kirchhoff import Electrode
     from yade_electro.yade import SceneReader
@@ -63,7 +63,7 @@ def bench_size(n, repeat=5, seed=1):
     # the continuum law's factors after a move (a new graph object: nothing cached), compiled
     # and numpy, interleaved
     import yade_electro.geometry.contacts as contacts
-    from yade_electro.laws.conductance import make_law
+    from yade_electro.laws.factors import make_law
     law = make_law("continuum")
     times = {True: [], False: []}
     for rep in range(4 * repeat):

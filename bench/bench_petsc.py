@@ -35,7 +35,7 @@ def log(msg):
 
 def worker(sizes):
     from bench_scale import RADIUS, jittered_rod, reduced_rod_system
-    from yade_electro.laws.conductance import conductance
+    from yade_electro.laws.factors import conductance
     from yade_electro.solvers.petsc import PETScSolver, import_petsc
     from yade_electro.solvers.registry import make_solver
     PETSc = import_petsc()

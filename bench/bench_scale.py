@@ -21,7 +21,7 @@ last layer) are the electrodes at 1 V / 0 V; law ``continuum``, rho_e of 304L. F
   eigen_ms (Eigen cold);
 * ``peak_rss_mb``: the process's peak resident memory so far (sizes run in increasing order);
 * the load average, and the BLAS thread limit (OpenBLAS is held to one thread here, as
-  inside YADE; see the README's *Scale* section).
+  inside YADE; see docs/benchmarks.md).
 
 ``--laws voronoi`` (default: both) times the ``voronoi`` law's pipeline instead, each size in
 a process of its own: the rod in its box, stages graph / tessellation (bounded Voronoi
@@ -130,7 +130,7 @@ def run_eigen(exe, path):
 
 
 def bench_size(n, repeat, exe, tmp):
-    from yade_electro.laws.conductance import conductance
+    from yade_electro.laws.factors import conductance
     from yade_electro.network.conduction import ConductionProblem
     from yade_electro.network.kirchhoff import Electrode
     from yade_electro.solvers.registry import auto_solver_name, make_solver
@@ -213,7 +213,7 @@ def bench_voronoi(n):
     """The ``voronoi`` law's pipeline on the rod of about n elements in its box: graph,
     tessellation (bounded cells, faces, the conducting network), conductances, the cold
     ConductionProblem solve, Joule heat. Run in a process of its own (peak RSS per size)."""
-    from yade_electro.laws.conductance import make_law
+    from yade_electro.laws.factors import make_law
     from yade_electro.geometry.shapes import Box
     from yade_electro.network.conduction import ConductionProblem
     from yade_electro.network.kirchhoff import Electrode

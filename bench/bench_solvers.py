@@ -43,7 +43,7 @@ SOLVERS = ("cg", "cg-deflated", "cg-amg", "direct")
 def rod_problem(n, seed=1):
     """(graph, conductances, electrodes) of the rod case's bonded packing (no YADE)."""
     import rod_resistance as rod
-    from yade_electro.laws.conductance import conductance
+    from yade_electro.laws.factors import conductance
     from yade_electro.geometry.shapes import Cylinder
     from yade_electro.core.graph import ContactGraph
     from yade_electro.network.kirchhoff import Electrode

@@ -32,7 +32,7 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=5)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from bench_scale import RADIUS, RHO, jittered_rod, reduced_rod_system
-    from yade_electro.laws.conductance import conductance
+    from yade_electro.laws.factors import conductance
     from yade_electro.solvers.registry import make_solver
     from yade_electro.core.threads import blas_threads, limit_blas_threads
     start = blas_threads()

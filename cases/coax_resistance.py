@@ -1,5 +1,5 @@
 """Radial resistance of a coaxial conductor with surface electrodes on both curved walls: the
-check of the half cells' curvature correction (issue 7; README *Boundaries at surfaces*).
+check of the half cells' curvature correction (docs/guide/electrodes-and-boundaries.md).
 
 A tube between r = a = 0.4 mm (a hole: a concave wall seen from the solid) and r = b = 1 mm
 (a convex wall), L = 1 mm, 304L-like rho_e = 7.3e-7 ohm m, packed by ``dense_packing`` in the

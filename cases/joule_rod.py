@@ -50,7 +50,7 @@ R_dem. Against the theory (power P_th = V^2 / R_th released in the volume pi R^2
      t / (rho c pi R^2 L) (= power factor x capacity factor);
   3. and, for the record, the rod mean against T(t) above (all three factors).
 
-  Measured at 5,000 elements, seed 1 (seeds 2, 3 in the README): voronoi core -0.32 %, rod
+  Measured at 5,000 elements, seed 1 (seeds 2, 3 in docs/validation.md): voronoi core -0.32 %, rod
   mean vs energy balance -0.15 %; continuum -2.7 % and -1.6 %. The core's own figures are
   printed too: the potential gradient in the core is 0.998 of V / L_eff for both models
   (the equipotential of a rough layer of electrode elements is not exactly at their mean

@@ -1,4 +1,4 @@
-"""A bonded rod solved with ``solver='petsc'`` on the ranks of ``mpiexec`` (issue 11).
+"""A bonded rod solved with ``solver='petsc'`` on the ranks of ``mpiexec``.
 
 The rod of ``rod_resistance.py`` (R = 1 mm, L = 5 mm, 304L, 1 V between its end layers) is
 built on every rank (the same seed, so the same scene); the electrical engine solves it
@@ -14,7 +14,7 @@ Run
 As root, OpenMPI needs ``--allow-run-as-root`` (or ``OMPI_ALLOW_RUN_AS_ROOT=1
 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1``). YADE 2023.02a notices ``mpiexec`` and prints
 "mpy already disconnected" at exit: its own MPI module (``yade.mpy``) is loaded but not
-used; see the README's *Scale* section for what works with it.
+used; see docs/benchmarks.md for what works with it.
 
 Ends with one JSON line (rank 0 only).
 """

@@ -106,7 +106,7 @@ VOLTAGE, T_END = 1.0, 0.01
 SIZES = (5000, 10000, 20000, 40000)
 LAWS = ("continuum", "voronoi", "voronoi-surface")
 #: a "law" of the sweep: the conductance law, with "-surface" for electrodes on the end faces
-#: themselves (surface electrodes, see yade_electro.geometry.surface_contact) instead of element layers
+#: themselves (surface electrodes, see yade_electro.geometry.boundary) instead of element layers
 FEM_HS = (0.1e-3, 0.05e-3, 0.025e-3)
 #: Paper 000 figure 12 / text: (N, r_mean [um]); errors [%]: resistance 9.2 (5k) -> 6.7 (40k),
 #: notch temperature ~12 (5k), 5.8 (10k), "around 7" (20k, 40k)

@@ -34,7 +34,7 @@ sys.path.insert(0, HERE)
 
 import rod_resistance as rod  # noqa: E402
 from yade_electro import ContactGraph, Electrode, eccentricity, solve_potential  # noqa: E402
-from yade_electro.laws.conductance import conductance  # noqa: E402
+from yade_electro.laws.factors import conductance  # noqa: E402
 from yade_electro.laws.transmission import polyhedron_volume_fraction  # noqa: E402
 from yade_electro.yade import packing as P  # noqa: E402
 

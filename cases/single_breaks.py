@@ -1,4 +1,4 @@
-"""Single bond breaks on the rod: does R_eq ever go down? (issue 7: a property of the model)
+"""Single bond breaks on the rod: does R_eq ever go down? (a property of the model)
 
 The rod R = 1 mm, L = 5 mm (surface electrodes on its end faces) is solved intact, then with
 one randomly chosen bond broken at a time (each from the intact rod), with paper 000's

@@ -103,7 +103,7 @@ class SlabModel:
     def __init__(self, layers=20, cross=2, length=LENGTH, conductivity=CONDUCTIVITY, density=DENSITY,
                  specific_heat=SPECIFIC_HEAT):
         from yade_electro.geometry.shapes import Box  # numpy only (no YADE import)
-        from yade_electro.laws.conductance import conductance
+        from yade_electro.laws.factors import conductance
         self.layers, self.cross, self.length = int(layers), int(cross), float(length)
         self.h = h = length / (layers + 0.5)
         nx, ny, nz = layers + 1, cross, cross

@@ -42,4 +42,4 @@ html_title = f"yade-electro {version}"
 html_theme_options = {"description": "Conduction, Joule heating and heat in DEM packings, for YADE",
                       "fixed_sidebar": True}
 nitpicky = False
-suppress_warnings = ["myst.header"]
+suppress_warnings = ["myst.header", "ref.python"]

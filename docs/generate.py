@@ -228,7 +228,71 @@ def bench_size_spread():
                  "bench_size_spread_latest.jsonl")
 
 
+FIGURES = {
+    "validation_granular": [
+        ("two_spheres.json", "max_error_pct", "two copper spheres against the closed form, largest error [% of 100 K]",
+         ".2g", "< 0.1"),
+        ("powder_column_n10.json", "slope_error_pct_hertz",
+         "pressed chain of 10 spheres, slope of log R against log F against -1/3 [%]", ".2g", "< 1"),
+        ("powder_column_n10.json", "slope_error_pct_plate", "the same, top sphere to the plate electrode [%]", ".2g",
+         "< 1"),
+        ("powder_column_n10.json", "max_R_check_error_pct",
+         "random bed pressed between plates: R against the network from YADE's forces [%]", ".2g", ""),
+        ("falling_bed/falling_bed_n2000.json", "energy_drift", "falling bed: largest drift of the stored heat",
+         ".1e", "< 1e-9"),
+        ("falling_bed/falling_bed_n2000.json", "ratio", "falling bed: k_eff of the network over the affine estimate",
+         ".3f", ""),
+        ("container_heating/container_heating_n2000.json", "balance_rel",
+         "container heated through its wall: wall heat against heat stored", ".1e", "< 1e-6"),
+        ("container_heating/container_heating_n2000.json", "t90_centre_s",
+         "container: the bed centre at 90 % of the wall temperature [s]", ".0f", ""),
+        ("cross_engine_heat/cross_engine_heat_all.json", "max_rel_diff_pct",
+         "the same heat problem in YADE and LIGGGHTS, largest difference [% of the range]", ".3f", "< 0.5"),
+    ],
+    "validation_pin": [
+        ("pin_torsion_n5000_s1.json", "elastic_torque_error_pct", "elastic torque against G J theta / h [%]", "+.3f",
+         "within 5"),
+        ("pin_torsion_n5000_s1.json", "theta_first_break_vs_yield_pct", "first broken bond against theta_y [%]",
+         "+.2f", "within 20"),
+        ("pin_torsion_n5000_s1.json", "theta_separation", "separation (R = inf, both laws) [rad]", ".4f",
+         "infinite once broken"),
+        ("pin_torsion_n5000_s1.json", "max_tau_ratio", "peak torque as tau / tau_y", ".2f", ""),
+        ("pin_torsion_n5000_s1.json", "kinetic_to_elastic_max", "kinetic / elastic energy before the first break",
+         ".1e", "quasi-static"),
+        ("pin_torsion_n5000_s1.json", "engine_share", "both engines' share of the wall time, every 100 steps",
+         ".3f", "< 0.10"),
+    ],
+}
+
+
+def figures(rows):
+    lines = ["| figure | value | target |", "|---|---|---|"]
+    sources = []
+    for name, key, label, spec, target in rows:
+        d = json.loads((RESULTS / name).read_text())
+        lines.append(f"| {label} | {fmt(d.get(key), spec)} | {target} |")
+        if name not in sources:
+            sources.append(name)
+    return "\n".join(lines) + "\n\n*Generated from " + ", ".join(f"`docs/results/{n}`" for n in sources) + ".*\n"
+
+
+def cross_packing():
+    d = json.loads((RESULTS / "cross_engine_packing/cross_engine_packing_n5000.json").read_text())
+    keys = ("n", "bed_height_m", "volume_fraction", "volume_fraction_core", "volume_fraction_wall", "coordination",
+            "coordination_core", "overlap_mean", "overlap_median", "k_eff_over_k")
+    lines = ["| figure | LIGGGHTS | YADE | YADE / LIGGGHTS - 1 |", "|---|---|---|---|"]
+    for k in keys:
+        lines.append(f"| {k} | {fmt(d['liggghts'][k], '.5g')} | {fmt(d['yade'][k], '.5g')} | "
+                     f"{100 * d['relative_difference'][k]:+.1f} % |")
+    lines.append(f"| overlaps, Kolmogorov-Smirnov | D = {d['ks_statistic']:.3f} | p = {d['ks_pvalue']:.2g} | "
+                 f"{'differ' if d['overlaps_differ'] else 'do not differ'} at 5 % |")
+    return "\n".join(lines) + "\n\n*Generated from `docs/results/cross_engine_packing/cross_engine_packing_n5000.json`.*\n"
+
+
 TABLES = {
+    "validation_granular": lambda: figures(FIGURES["validation_granular"]),
+    "validation_pin": lambda: figures(FIGURES["validation_pin"]),
+    "validation_cross_packing": cross_packing,
     "validation_rod": rod_resistance, "validation_joule_rod": joule_rod, "validation_slab": slab,
     "validation_plate": plate, "validation_notched": notched, "validation_edge_crack": edge_crack,
     "bench_solvers": bench_solvers, "bench_live": bench_live, "bench_coupled": bench_coupled,

@@ -5,7 +5,7 @@ import pytest
 
 from yade_electro.geometry.clipping import FaceSet, clip, face_areas, order_polygons, volumes
 from yade_electro.geometry.shapes import Box, Cylinder
-from yade_electro.geometry.bounded_cells import bounded_cells
+from yade_electro.geometry.cells import bounded_cells
 
 
 def cubes(offsets):

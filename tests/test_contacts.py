@@ -8,7 +8,7 @@ import pytest
 
 from yade_electro.geometry.contacts import (WallGeometry, candidate_pairs, plane_contact_radius, triangle_distance,
                                    wall_candidates, wall_overlaps)
-from yade_electro.laws.conductance import make_law
+from yade_electro.laws.factors import make_law
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.core.errors import BoundaryConditionError
 from yade_electro.core.graph import ContactGraph
@@ -46,7 +46,7 @@ def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
     einsum sums the squares in another order, is amplified in a^2 = r1^2 - x^2 for small
     contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way."""
     import yade_electro.geometry.contacts as C
-    from yade_electro.laws.conductance import contact_radius, edge_lengths
+    from yade_electro.laws.factors import contact_radius, edge_lengths
     from yade_electro.core.errors import MaterialError
     from yade_electro.native import NativeError, contact_radii
     try:
@@ -247,7 +247,7 @@ def test_wall_inputs_are_checked():
 
 
 def test_feng_pipe_law():
-    from yade_electro.laws.conductance import PipeLaw
+    from yade_electro.laws.factors import PipeLaw
     r, w, a = 1e-3, 5e-3, 0.2e-3
     d = 2 * math.sqrt(r ** 2 - a ** 2)                    # half chord a
     g = ContactGraph(np.array([[0, 0, 0], [d, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))

@@ -2,7 +2,7 @@
 
 Bonds broken in YADE (``cohesionBroken``) across half the mid-section; the engine sees them at
 its next call. Stated tolerances at 2,000 elements (measured: facets +10.0 %, paths -13.9 %
-against the closed form; the README has 10,000 and 20,000 against the FEM): the facet rule
+against the closed form; docs/validation.md has 10,000 and 20,000 against the FEM): the facet rule
 within 15 % and with under half the leak of the path rule.
 """
 import os

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from yade_electro import BoundaryConditionError, MaterialError, equivalent_resistance
-from yade_electro.laws.conductance import conductance
+from yade_electro.laws.factors import conductance
 from yade_electro.physics.electrical import ElectricalModel, ElectrodeSpec
 from yade_electro.core.selection import select_nodes
 from yade_electro.core.history import History

@@ -1,7 +1,7 @@
 """The Joule-heating rod case (cases/joule_rod.py) in the real YADE, on a small rod (1,000
 elements, seed 1, 1 V, 0.01 s adiabatic, 10 engine calls of 1 ms).
 
-Stated tolerances at N = 1,000 (measured values in brackets; the README has 5,000):
+Stated tolerances at N = 1,000 (measured values in brackets; docs/validation.md has 5,000):
 * 'voronoi' model (Voronoi conductances and cell-volume capacities): core temperature rise
   within 1.5 % of T(t) = T0 + (V/L_eff)^2/rho_e t/(rho c) (-0.74 %); rod mean within 1 % of
   the whole rod's energy balance (-0.55 %); the cell volumes sum to the rod volume within

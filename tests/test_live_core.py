@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from yade_electro import BoundaryConditionError, ContactGraph, Electrode, MaterialError
-from yade_electro.laws.conductance import conductance
+from yade_electro.laws.factors import conductance
 from yade_electro.physics.electrical import ElectricalModel, ElectrodeSpec
 from yade_electro.core.history import History
 from yade_electro.core.materials import Material

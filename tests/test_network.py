@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from yade_electro import (BoundaryConditionError, ContactGraph, Electrode, MaterialError, SolverError,
                           equivalent_resistance, laplacian, make_solver, solve_potential)
-from yade_electro.laws.conductance import conductance
+from yade_electro.laws.factors import conductance
 from yade_electro.network.conduction import ConductionProblem
 from yade_electro.solvers.cg import CGSolver
 from yade_electro.solvers.base import DirectSolver

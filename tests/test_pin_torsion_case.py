@@ -153,7 +153,7 @@ def test_bonds_broken_one_by_one_equal_a_fresh_engine(run_yade_script):
     for live, fresh, r0 in zip(out["half_live"], out["half_fresh"], out["R0"]):
         assert live == pytest.approx(fresh, rel=1e-9)
         assert live > 1.05 * r0
-    assert out["rising"]                 # no single break lowers the voronoi R (the continuum's can: README)
+    assert out["rising"]                 # no single break lowers the voronoi R (the continuum's can: docs/guide/cracks-and-fracture.md)
     # the whole section cut: R = inf for the live and the fresh engines
     assert all(math.isinf(x) for x in out["cut_live"] + out["cut_fresh"])
 

@@ -16,7 +16,7 @@ sys.path.insert(0, os.path.join(ROOT, "cases"))
 
 
 def test_contact_radius_models():
-    from yade_electro.laws.conductance import contact_radius, make_law
+    from yade_electro.laws.factors import contact_radius, make_law
     from yade_electro.core.graph import ContactGraph
     r, delta = 1e-3, 1e-6
     g = ContactGraph(np.array([[0, 0, 0], [2 * r - delta, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))

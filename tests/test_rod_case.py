@@ -1,6 +1,6 @@
 """The rod case (cases/rod_resistance.py) in the real YADE, on a small rod (1,000 elements).
 
-Stated tolerances at N = 1,000 (the README has the full sweep):
+Stated tolerances at N = 1,000 (docs/validation.md has the full sweep):
 * 'voronoi' law: |R_dem - R_th| / R_th < 2 %;
 * paper 000 continuum law: the error is what the model gives on our packings, +10 % to
   +25 % at this size (measured +14.5 % to +17.8 % over three seeds); the test pins that band

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph, MaterialError, conductance_laws, register_conductance_law
-from yade_electro.laws.conductance import ConductanceLaw, conductance, contact_radius, unregister_conductance_law
+from yade_electro.laws.factors import ConductanceLaw, conductance, contact_radius, unregister_conductance_law
 from yade_electro.laws.transmission import (POLYHEDRON_ALPHA, POLYHEDRON_FACES, POLYHEDRON_FV,
                                    eccentricity, eccentricity_factor, edge_transmission_surface,
                                    polyhedron_alpha, polyhedron_volume_fraction,
@@ -245,7 +245,7 @@ def test_compiled_continuum_factors_are_the_numpy_ones(monkeypatch):
     must agree there too) and a jittered random bond graph, g the same to 1e-13 relative and
     the same eccentricity factors; coincident centres a MaterialError either way."""
     import yade_electro.geometry.contacts as C
-    from yade_electro.laws.conductance import make_law
+    from yade_electro.laws.factors import make_law
     from yade_electro.native import NativeError, continuum_factors
     try:
         continuum_factors(np.zeros((1, 3)), np.ones(1), np.ones(1), np.zeros((0, 2), dtype=np.int64), 0.4, 2.0)

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph, MaterialError, ThermalError, solve_potential
-from yade_electro.laws.conductance import conductance
+from yade_electro.laws.factors import conductance
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.physics.electrical import ElectricalModel
 from yade_electro.core.history import History

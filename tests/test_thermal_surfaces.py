@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph
-from yade_electro.geometry.surface_contact import boundary_areas
+from yade_electro.geometry.boundary import boundary_areas
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.core.errors import BoundaryConditionError, ThermalError
 from yade_electro.geometry.shapes import Box, Cylinder, Difference
 from yade_electro.geometry.surfaces import Plane
 from yade_electro.packing import bond_pairs, dense_packing
 from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
-from yade_electro.geometry.bounded_cells import bounded_cells
+from yade_electro.geometry.cells import bounded_cells
 
 R, L = 1e-3, 5e-3
 LAM, RHO, CP = 15.0, 7900.0, 500.0
@@ -143,7 +143,7 @@ def test_wall_curvature_is_that_of_the_smooth_piece_at_the_point():
 
 
 def test_half_cell_length_is_exact_under_cylindrical_walls():
-    from yade_electro.geometry.surface_contact import CURVATURE_LIMITS, half_cell_length
+    from yade_electro.geometry.boundary import CURVATURE_LIMITS, half_cell_length
     a, d = 0.4e-3, 50e-6
     assert half_cell_length(d, -1 / a) == pytest.approx(a * math.log(1 + d / a), rel=1e-12)     # hole
     assert half_cell_length(d, 1 / R) == pytest.approx(R * math.log(R / (R - d)), rel=1e-12)     # rod side

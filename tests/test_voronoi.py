@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from yade_electro import ContactGraph
-from yade_electro.laws.conductance import conductance, make_law
+from yade_electro.laws.factors import conductance, make_law
 from yade_electro.physics.electrical import ElectricalModel
 from yade_electro.geometry.shapes import Box
 from yade_electro.network.conduction import equivalent_resistance

@@ -46,7 +46,7 @@ TOP = pack.inAlignedBox((-1, -1, zmax - 0.5 * r), (1, 1, 1))
 BOTTOM = pack.inAlignedBox((-1, -1, -1), (1, 1, zmin + 0.5 * r))
 
 from yade_electro import ContactGraph, equivalent_resistance
-from yade_electro.laws.conductance import conductance
+from yade_electro.laws.factors import conductance
 from yade_electro.yade import ElectricalEngine, Electrode, Material, Output, Reader
 
 

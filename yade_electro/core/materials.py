@@ -11,7 +11,7 @@ An edge between two elements is two half-length rods in series, so
 * its conductivity is the harmonic mean of theirs (:func:`edge_conductivity`),
 
 and the conductances are ``c = g / rho_edge`` [S] and ``G = lambda_edge g`` [W/K] for the
-geometric factor ``g`` [m] of a conductance law (:mod:`yade_electro.laws.conductance`).
+geometric factor ``g`` [m] of a conductance law (:mod:`yade_electro.laws.factors`).
 
 Units: SI (ohm m, 1/K, K, kg/m^3, J/(kg K), W/(m K)).
 """

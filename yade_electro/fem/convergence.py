@@ -5,9 +5,9 @@ Three solutions q1, q2, q3 on meshes of size h1 > h2 > h3 give the observed orde
     (q1 - q2) / (q2 - q3) = (h1^p - h2^p) / (h2^p - h3^p),
 
 the extrapolated value q_ext = q3 + (q3 - q2) h3^p / (h2^p - h3^p), and the grid
-convergence index of the finest solution GCI = Fs |q3 - q2| / ((h2/h3)^p - 1) with the
+convergence index of the finest solution GCI = Fs ``|q3 - q2|`` / ((h2/h3)^p - 1) with the
 safety factor Fs = 1.25 (Roache 1994, ASME V&V 20). GCI is the error estimate we quote
-for the finest solution; |q_ext - q3| is the (smaller) Richardson estimate. When
+for the finest solution; ``|q_ext - q3|`` is the (smaller) Richardson estimate. When
 convergence is not monotone (oscillating differences) or the observed order is
 implausible, the expected order is used with Fs = 3, and ``monotone`` is False.
 """

@@ -11,14 +11,16 @@ along it, so nothing is lost).
 
 Boundary names
 --------------
-box            ``x0 x1 y0 y1 z0 z1`` and, along ``axis``, ``end0 end1`` and ``surface`` (the rest)
-rod            ``end0`` (z = 0), ``end1`` (z = L), ``surface`` (lateral)
-coax           ``inner`` (r = r1), ``outer`` (r = r2), ``end0``, ``end1``
-plate          ``bottom`` (y = 0, the ground), ``top``, ``left``, ``right``, ``front`` (z = 0),
-               ``back`` (z = t), ``source`` (the hole, r = d/2 around the centre)
-notched bar    ``end0`` (x = 0), ``end1`` (x = L), ``notch`` (notch faces), ``surface``
-               (every face except the ends; includes ``notch``); subdomain ``notch``
-               (|x - L/2| <= notch_width/2, meshed conformingly)
+::
+
+    box            ``x0 x1 y0 y1 z0 z1`` and, along ``axis``, ``end0 end1`` and ``surface`` (the rest)
+    rod            ``end0`` (z = 0), ``end1`` (z = L), ``surface`` (lateral)
+    coax           ``inner`` (r = r1), ``outer`` (r = r2), ``end0``, ``end1``
+    plate          ``bottom`` (y = 0, the ground), ``top``, ``left``, ``right``, ``front`` (z = 0),
+                   ``back`` (z = t), ``source`` (the hole, r = d/2 around the centre)
+    notched bar    ``end0`` (x = 0), ``end1`` (x = L), ``notch`` (notch faces), ``surface``
+                   (every face except the ends; includes ``notch``); subdomain ``notch``
+                   (``|x - L/2| <= notch_width/2``, meshed conformingly)
 
 All lengths in metres.
 """

@@ -222,7 +222,7 @@ class PotentialSolution:
         return s, self.probe(x.T)
 
     def power_density(self) -> np.ndarray:
-        """Joule power density |grad V|^2 / rho at the quadrature points [W/m^3]."""
+        """Joule power density ``|grad V|^2 / rho`` at the quadrature points [W/m^3]."""
         g = self.basis.interpolate(self.u).grad
         return self.conductivity * np.sum(g * g, axis=0)
 

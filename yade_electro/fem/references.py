@@ -207,7 +207,7 @@ def slab_conduction(length: float = 10e-3, h: float = 0.5e-3, t_end: float = 5.0
     -------
     dict
         ``x`` [m], ``T`` (FEM at t_end) and ``T_exact`` [K], ``max_error`` [K],
-        ``relative_error`` (max error / |T1 - T0|), ``h``, ``dt``.
+        ``relative_error`` (max error / ``|T1 - T0|``), ``h``, ``dt``.
     """
     if nsteps is None:
         nsteps = max(10, int(math.ceil(t_end * material.diffusivity / (0.5 * h * h))))

@@ -1,4 +1,4 @@
-"""Heat conduction with Joule sources: rho_c dT/dt = div(lambda grad T) + |grad V|^2 / rho.
+"""Heat conduction with Joule sources: ``rho_c dT/dt = div(lambda grad T) + |grad V|^2 / rho``.
 
 Time integration is the theta method on the finite-element system
 
@@ -85,7 +85,7 @@ class ThermalResult:
 
     @property
     def energy_balance_error(self) -> float:
-        """|gained - (Joule + boundary)| / max(|gained|, |Joule|, |boundary|) (round-off)."""
+        """``|gained - (Joule + boundary)|`` / max(``|gained|``, ``|Joule|``, ``|boundary|``) (round-off)."""
         supplied = self.joule_energy + sum(self.boundary_heat.values())
         scale = max(abs(self.heat_gained), abs(self.joule_energy),
                     *(abs(v) for v in self.boundary_heat.values()), 1e-300)

@@ -189,7 +189,7 @@ def sampled_boundary(hs, guess, container, k=48, bin_width=0.35):
     cells at re-entrant corners, where tangent planes would cut solid away): the points of a
     k^3 grid over the cell's box that lie in the cell and within ``eps`` = 3 grid spacings
     inside the surface, grouped by their outward normal (bins of ``bin_width`` in each
-    component). Each group's area is its shell volume / eps (the coarea formula, |grad sdf|
+    component). Each group's area is its shell volume / eps (the coarea formula, ``|grad sdf|``
     = 1), its normal the mean gradient, its point the mean of the points moved onto the
     surface. Returns (areas, normals, points), each (f, ...)."""
     from scipy.spatial import HalfspaceIntersection

@@ -448,7 +448,7 @@ class GridShape(Shape):
     def wall_curvature(self, x, h=None):
         """Zero [1/m]: a field interpolated trilinearly from voxels has no usable second
         derivative, so the walls of a sampled shape are taken as flat (surface conditions on
-        them get no curvature correction; see :mod:`yade_electro.geometry.surface_contact`)."""
+        them get no curvature correction; see :mod:`yade_electro.geometry.boundary`)."""
         return np.zeros(_pts(x).shape[0])
 
     def key(self):

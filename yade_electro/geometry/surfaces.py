@@ -46,7 +46,7 @@ class Plane(SurfaceSelector):
 
 
 class OnSurface(SurfaceSelector):
-    """The faces on a shape's boundary (|sdf| <= tol)."""
+    """The faces on a shape's boundary (``|sdf|`` <= tol)."""
 
     def __init__(self, shape, tol=None):
         lo, hi = shape.bounds()

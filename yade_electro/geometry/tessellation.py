@@ -42,7 +42,7 @@ CHUNK = 100_000
 
 
 def circumcentres(points, simplices, neighbors=None):
-    """Circumcentres (T, 3) of tetrahedra (T, 4). Flat ones (|det| <= 1e-12 of the product of
+    """Circumcentres (T, 3) of tetrahedra (T, 4). Flat ones (``|det|`` <= 1e-12 of the product of
     their edge lengths) take a non-flat neighbour's circumcentre (``neighbors``: qhull's
     (T, 4) adjacency, -1 for none); without neighbours they are NaN."""
     a = points[simplices[:, 0]]

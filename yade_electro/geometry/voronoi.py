@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bounded_cells import bounded_cells
+from .cells import bounded_cells
 from .cell_clipping import clipped_by_planes
 from .ghosts import ghost_points, tessellate_with_ghosts
 

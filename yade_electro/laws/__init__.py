@@ -2,9 +2,9 @@
 (paper 000's transmission surfaces), 'voronoi', 'contact', 'liggghts'. A conductance is g times a
 material value (g / rho_e, lambda g).
 """
-from .conductance import (conductance, geometric_factor, conductance_laws, register_conductance_law,
-                          make_law, check_law_name, is_contact_law, unregister_conductance_law,
-                          contact_radius, edge_lengths, ConductanceLaw, FactorNetwork)
+from .factors import (conductance, geometric_factor, conductance_laws, register_conductance_law, make_law,
+                      check_law_name, is_contact_law, unregister_conductance_law, contact_radius,
+                      edge_lengths, ConductanceLaw, FactorNetwork)
 from .law import Law
 from .transmission import (POLYHEDRON_FACES, POLYHEDRON_ALPHA, POLYHEDRON_FV, polyhedron_alpha,
                            polyhedron_volume_fraction, eccentricity, eccentricity_factor,

@@ -7,7 +7,7 @@ from __future__ import annotations
 from types import MappingProxyType
 from typing import Any, Mapping, Optional
 
-from .conductance import check_law_name
+from .factors import check_law_name
 
 __all__ = ["Law"]
 

@@ -85,7 +85,7 @@ def polyhedron_volume_fraction(n) -> np.ndarray:
 
 
 def eccentricity(graph: ContactGraph) -> np.ndarray:
-    """e_i = |x_i - mean_j x_j| / r_i over the bonded neighbours j of each node (0 for a
+    """e_i = ``|x_i - mean_j x_j|`` / r_i over the bonded neighbours j of each node (0 for a
     node without neighbours)."""
     d = graph.neighbour_barycentre() - graph.pos
     return np.sqrt(np.einsum("ij,ij->i", d, d)) / graph.radius

@@ -24,7 +24,7 @@ without g++) took about 10 s and 1 GB.
 (:func:`laplacian_fill`, used by :class:`yade_electro.network.condensation.ReducedSystem`), numpy's
 operations in one pass, the same values to the last bit; measured on the rod problems in
 one process, 0.17 against 0.36-0.38 ms at 5,000 elements and 0.47-0.62 against 1.39-1.44 ms
-at 20,000 (2026-12-03).
+at 20,000.
 
 ``wall_contacts``: sphere-triangle distances and the candidate (sphere, triangle) pairs of
 the granular mode's facet walls (:func:`triangle_distance`, :func:`triangle_candidates`), the
@@ -32,12 +32,12 @@ numpy form's closest-point regions in one compiled pass; and the facets' world v
 their poses (:func:`facet_vertices`).
 
 ``contact_radii``: the contact radius of each sphere pair of the granular mode's Verlet list
-(:func:`contact_radii`, used by :func:`yade_electro.laws.conductance.contact_radius`) and the
+(:func:`contact_radii`, used by :func:`yade_electro.laws.factors.contact_radius`) and the
 centre distances of node pairs (:func:`pair_lengths`, used by
-:func:`yade_electro.laws.conductance.edge_lengths`), numpy's operations in one pass.
+:func:`yade_electro.laws.factors.edge_lengths`), numpy's operations in one pass.
 
 ``continuum_factors``: the geometric factors of the ``continuum`` law on every bond
-(:func:`continuum_factors`, used by :class:`yade_electro.laws.conductance.ContinuumLaw`): the
+(:func:`continuum_factors`, used by :class:`yade_electro.laws.factors.ContinuumLaw`): the
 neighbours' barycentres, the eccentricity factors and sqrt(S_i S_j) / l_ij in three passes.
 
 ``csr_pattern``: a CSR sparsity pattern from (row, col) pairs with each pair's slot in the
@@ -266,7 +266,7 @@ class FireSteps:
         return float(self._out[0]), float(self._out[1]), int(m)
 
     def power(self, F, v):
-        """(max_i |F_i|, F.v, |v|, |F|)."""
+        """(max_i ``|F_i|``, F.v, ``|v|``, ``|F|``)."""
         self._check(F, v)
         self._power(F.shape[0], F.ctypes.data, v.ctypes.data, self._out.ctypes.data)
         o = self._out
@@ -278,7 +278,7 @@ class FireSteps:
         self._move(x.shape[0], x.ctypes.data, v.ctypes.data, F.ctypes.data, float(a), float(b), float(dt))
 
     def max_move(self, x, ref) -> float:
-        """max_i |x_i - ref_i|."""
+        """max_i ``|x_i - ref_i|``."""
         self._check(x, ref)
         return float(np.sqrt(self._max_move2(x.shape[0], x.ctypes.data, ref.ctypes.data)))
 
@@ -396,7 +396,7 @@ def facet_vertices(pos, quat, local) -> np.ndarray:
 
 def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
     """Contact radius a [m] of each sphere pair ``edges`` (m, 2) (0 where the spheres do not
-    overlap), as :func:`yade_electro.laws.conductance.contact_radius` computes it with numpy
+    overlap), as :func:`yade_electro.laws.factors.contact_radius` computes it with numpy
     (``model`` 'geometric' or 'hertz'; ``shift`` (m, 3): the periodic image of the second
     sphere), and the number of pairs with coincident centres (their radii are not
     meaningful); ``contact_radii.cpp``, one pass. Raises :class:`NativeError` when it cannot
@@ -420,7 +420,7 @@ def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
 
 
 def pair_lengths(pos, edges, shift=None):
-    """Centre distances |x_j - x_i (+ shift)| [m] of the node pairs ``edges`` (m, 2), and how
+    """Centre distances ``|x_j - x_i (+ shift)|`` [m] of the node pairs ``edges`` (m, 2), and how
     many are zero; ``contact_radii.cpp``. Raises :class:`NativeError` when it cannot be built."""
     import ctypes
     i64, ptr = ctypes.c_int64, ctypes.c_void_p
@@ -441,7 +441,7 @@ def continuum_factors(pos, radius, alpha_r2, edges, threshold: float, factor: fl
     """g = sqrt(S_i S_j) / l_ij [m] of every bond ``edges`` (m, 2) of the ``continuum`` law,
     S_i = ``alpha_r2``[i] / f_i with the eccentricity factor f_i of the bonds' neighbour
     barycentres (as :func:`yade_electro.laws.transmission.edge_transmission_surface` over
-    :func:`yade_electro.laws.conductance.edge_lengths` computes them with numpy), and the number
+    :func:`yade_electro.laws.factors.edge_lengths` computes them with numpy), and the number
     of bonds with coincident centres (their g is not meaningful); ``continuum_factors.cpp``.
     Raises :class:`NativeError` when it cannot be built."""
     import ctypes

@@ -38,7 +38,7 @@ def _check_bc(bc, kind):
         if getattr(bc, "area", None) is not None:
             raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: a surface condition takes its areas "
                                          "from the boundary faces on the surface; do not give area=")
-        from ..geometry.surface_contact import check_surface
+        from ..geometry.boundary import check_surface
         check_surface(surface, f"{kind} boundary condition {bc.name!r}")
         return
     if bc.nodes is None:
@@ -70,7 +70,7 @@ class FixedTemperature:
     (:func:`~yade_electro.physics.thermal.heat_solver_on_graph`, ``ElectroThermalModel``), anything
     ``yade_electro.core.selection.select_nodes`` takes (callable, mask, graph ids): those
     elements are held at ``temperature``. ``surface``: a surface of the container
-    (``shape.face('top')``, see :mod:`yade_electro.geometry.surface_contact`; needs ``ElectroThermalModel``):
+    (``shape.face('top')``, see :mod:`yade_electro.geometry.boundary`; needs ``ElectroThermalModel``):
     the surface is held at ``temperature`` and each element with boundary faces on it
     exchanges heat with it through its half cell, ``lambda sum_f A_f / d_f`` [W/K] (the
     finite-volume Dirichlet condition). Give one of them."""

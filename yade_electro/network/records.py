@@ -27,7 +27,7 @@ class PotentialSolution:
     electrode_potential, electrode_current : dict name -> V, A (current fed into the network)
     floating : (n,) bool, nodes in parts with no potential reference (no current, potential 0)
     residual : largest relative residual of the linear solves behind this solution
-    current_imbalance : |sum of electrode currents + injections| / max |electrode current|
+    current_imbalance : ``|sum of electrode currents + injections|`` / max ``|electrode current|``
     component_of_electrode : dict name -> connected part label
     conductance_matrix : (ne, ne) S [S], electrode currents I = S V (+ injection part)
     info : solver information (name, iterations, times)
@@ -99,13 +99,21 @@ class ThermalState:
 class HeatStep:
     """What one :meth:`HeatSolver.advance` did (energies in J over the step).
 
-    source_energy : the given sources (e.g. Joule) on free nodes, integrated over dt
-    absorbed_energy : given sources that fell on fixed-temperature nodes (taken by the thermostat)
-    flux_energy : imposed heat fluxes (HeatFlux)
-    convection_energy : heat received from the ambient by convection (negative when cooling)
-    boundary_energy : heat received from the fixed-temperature nodes
-    heat_change : sum_i C_i (T_i^{n+1} - T_i^n) over free nodes; equals the sum of the four
-        inputs above (to rounding) for every theta
+    Attributes
+    ----------
+    source_energy : float
+        The given sources (e.g. Joule) on free nodes, integrated over dt.
+    absorbed_energy : float
+        Given sources that fell on fixed-temperature nodes (taken by the thermostat).
+    flux_energy : float
+        Imposed heat fluxes (HeatFlux).
+    convection_energy : float
+        Heat received from the ambient by convection (negative when cooling).
+    boundary_energy : float
+        Heat received from the fixed-temperature nodes.
+    heat_change : float
+        ``sum_i C_i (T_i^{n+1} - T_i^n)`` over free nodes; equals the sum of the four inputs
+        above (to rounding) for every theta.
     """
 
     time: float
@@ -121,7 +129,7 @@ class HeatStep:
 
     @property
     def balance_error(self) -> float:
-        """|heat_change - inputs| / max(|terms|): a check of the integration's energy balance."""
+        """``|heat_change - inputs|`` / max(``|terms|``): a check of the integration's energy balance."""
         inputs = self.source_energy + self.flux_energy + self.convection_energy + self.boundary_energy
         scale = max(abs(self.heat_change), abs(self.source_energy), abs(self.flux_energy),
                     abs(self.convection_energy), abs(self.boundary_energy)) or 1.0
@@ -149,6 +157,6 @@ class SteadyHeat:
 
     @property
     def balance_error(self) -> float:
-        """|sum of the powers| / max |power|: zero at the exact steady state."""
+        """``|sum of the powers|`` / max ``|power|``: zero at the exact steady state."""
         terms = (self.source_power, self.flux_power, self.convection_power, self.boundary_power)
         return abs(sum(terms)) / (max(abs(t) for t in terms) or 1.0)

@@ -77,7 +77,7 @@ def bed_statistics(centers, radii, cylinder_radius: float, floor: float = 0.0, c
     contact ``law`` (each contact conducts k g_ij), between the spheres within one d of
     the core's bottom and of its top, over the cross-section pi R^2, divided by ``k``.
     """
-    from ..laws.conductance import make_law
+    from ..laws.factors import make_law
     from ..core.graph import ContactGraph
     from ..network.conduction import equivalent_resistance
     c = np.asarray(centers, dtype=float).reshape(-1, 3)

@@ -1,5 +1,7 @@
-"""Placement by jamming: FIRE relaxation of a soft-sphere overlap energy with the exact
-container wall, while the radii grow (the O'Hern et al. 2003 protocol). numpy/scipy only.
+"""Placement by jamming, numpy/scipy only.
+
+FIRE relaxation of a soft-sphere overlap energy with the exact container wall, while the
+radii grow (the O'Hern et al. 2003 protocol).
 
 Everything here works in units of a reference radius ``r0`` (positions ``x``, radii
 ``rho``); :func:`yade_electro.packing.dense_packing` converts to metres.
@@ -104,9 +106,9 @@ class NumpyFireSteps:
 class Relaxer:
     """Soft-sphere overlap energy minimiser in units of the mean radius.
 
-    Energy U = 1/2 sum_pairs max(0, s(rho_i + rho_j) - d_ij)^2
-             + 1/2 sum_i max(0, sdf(x_i) + s rho_i)^2,
-    minimised with FIRE (Bitzek et al. 2006) using a Verlet pair list (cKDTree).
+    The energy ``U = 1/2 sum_pairs max(0, s(rho_i + rho_j) - d_ij)^2 + 1/2 sum_i max(0,
+    sdf(x_i) + s rho_i)^2`` is minimised with FIRE (Bitzek et al. 2006) using a Verlet pair
+    list.
     """
 
     def __init__(self, shape, rho, r0, skin=0.4, native=True, spatial=False):

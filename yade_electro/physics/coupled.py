@@ -37,14 +37,14 @@ from typing import Mapping, Optional, Sequence
 import numpy as np
 
 from ..geometry.contacts import new_wall_contacts
-from ..laws.conductance import FactorNetwork, make_law
+from ..laws.factors import FactorNetwork, make_law
 from .electrical import ElectricalModel
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
 from ..core.history import History
 from ..core.materials import Material, edge_conductivity, real_number
 from ..core.selection import Membership
-from ..geometry.surface_contact import BoundaryOfGraph, SurfaceMembership
+from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
 from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
 from ..network.transient import HeatSolver
 from ..network.theta import theta_of
@@ -83,7 +83,7 @@ class ElectroThermalModel:
     fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
         Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
         on the first graph and then kept by element id; or ``surface=`` a surface of the
-        ``container`` (see :mod:`yade_electro.geometry.surface_contact`): a fixed temperature then acts through
+        ``container`` (see :mod:`yade_electro.geometry.boundary`): a fixed temperature then acts through
         the touching elements' half cells, a flux on their boundary faces' areas, convection
         on those areas in series with the half cells.
     sources : sequence of HeatSource, optional
@@ -487,7 +487,7 @@ class ElectroThermalModel:
         temperatures are iterated (fixed point) until the sources change by less than
         ``coupling_tol`` (relative), at most ``max_iterations`` times (a warning if not: a
         thermal runaway has no steady state). Returns the history row, with
-        ``steady_iterations`` and ``steady_balance_error`` (|sum of powers| / max power)."""
+        ``steady_iterations`` and ``steady_balance_error`` (``|sum of powers|`` / max power)."""
         self.prepare(graph)
         heat = self.heat
         self._set_resistivity(heat.temperature)

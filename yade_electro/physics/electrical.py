@@ -27,7 +27,7 @@ from typing import Dict, List, Mapping, Optional, Sequence
 import numpy as np
 
 from ..geometry.contacts import new_wall_contacts
-from ..laws.conductance import ConductanceLaw, FactorNetwork, make_law
+from ..laws.factors import ConductanceLaw, FactorNetwork, make_law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
 from ..core.materials import Material, edge_resistivity, positive_property
@@ -49,7 +49,7 @@ class ElectrodeSpec:
 
     ``select``: the element layer the electrode is (paper 000's convention: a perfect conductor
     through the selected elements' centres). ``surface``: a surface of the container (e.g.
-    ``container.face('top')``, see :mod:`yade_electro.geometry.surface_contact`): the electrode is that surface,
+    ``container.face('top')``, see :mod:`yade_electro.geometry.boundary`): the electrode is that surface,
     each element with boundary faces on it connected through its half cell. ``wall=True``: a
     wall of a granular bed (a plate), each particle touching it connected through its contact
     (the contact law's sphere-wall factor, :meth:`ElectricalModel.set_wall_contacts` gives the
@@ -73,7 +73,7 @@ class ElectrodeSpec:
                                          "or a mask), surface= (a surface of the container) or wall= (a wall of a "
                                          "granular bed), one of them")
         if self.surface is not None:
-            from ..geometry.surface_contact import check_surface
+            from ..geometry.boundary import check_surface
             check_surface(self.surface, f"electrode {self.name!r}")
         elif not self.wall:
             check_selector(self.select, f"electrode {self.name!r}: select")
@@ -133,7 +133,7 @@ class ElectricalModel:
         Electrical resistivity rho_e [ohm m], > 0 (304L steel: 0.73e-6), or a Material.
     electrodes : mapping name -> dict(select=..., potential=V | current=A), or ElectrodeSpecs
     law : str or ConductanceLaw
-        Conductance law name (``yade_electro.laws.conductance.conductance_laws()``).
+        Conductance law name (``yade_electro.laws.factors.conductance_laws()``).
     law_params : dict, optional
         Parameters of the law (``container`` for 'voronoi'; ``threshold``, ``factor`` for
         'continuum').
@@ -181,7 +181,7 @@ class ElectricalModel:
         self._wall_nodes = {}                 # name -> the nodes of its edges in the kept problem
         self._walls_stale = False
         self.container = container if container is not None else getattr(self.law, "container", None)
-        from ..geometry.surface_contact import BoundaryOfGraph, SurfaceMembership
+        from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
         self.surfaces: Dict[str, SurfaceMembership] = {s.name: SurfaceMembership(s.name, s.surface)
                                                        for s in self.specs if s.surface is not None}
         self._boundary = None
@@ -382,7 +382,7 @@ class ElectricalModel:
     def update(self, graph: ContactGraph) -> Optional[str]:
         """Bring the kept problem to ``graph``; returns what changed: None, 'resistivity',
         'geometry', 'topology' or 'structure' (see the module doc and
-        :class:`~yade_electro.laws.conductance.FactorNetwork`)."""
+        :class:`~yade_electro.laws.factors.FactorNetwork`)."""
         if not isinstance(graph, ContactGraph):
             raise TypeError(f"expected a ContactGraph, got {type(graph).__name__}")
         kind = self.network.update(graph)

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..core.graph import ContactGraph
 from ..core.materials import edge_conductivity, positive_property
-from ..laws.conductance import make_law
+from ..laws.factors import make_law
 from ..laws.transmission import volume_fraction as _volume_fraction
 from ..network.kirchhoff import edge_power
 from ..network.conditions import Convection, FixedTemperature
@@ -166,7 +166,7 @@ def surface_conditions(conditions, contacts: dict, conductivity):
     ----------
     conditions : sequence of FixedTemperature, HeatFlux and Convection; those with no
         ``surface`` are skipped
-    contacts : dict name -> :class:`~yade_electro.geometry.surface_contact.SurfaceContact`
+    contacts : dict name -> :class:`~yade_electro.geometry.boundary.SurfaceContact`
         of each surface condition on the current graph
     conductivity : float or (n,) [W/(m K)]
 

@@ -7,7 +7,7 @@ logs and :func:`results_table` puts one row per job in a pandas DataFrame: the j
 status, exit status, duration [s] and log, then the figures of its JSON line (nested
 objects flattened to ``outer.inner`` columns, lists kept as JSON text).
 
-From the command line (after ``yade-electro batch -j 2 --log '/tmp/sweep/$.@.log' table script.py``):
+From the command line (after ``yade-electro batch -j 2 --log '/tmp/sweep/$.@.log' table script.py``)::
 
     yade-electro gather '/tmp/sweep/*.log' --out sweep.csv [--columns job,n,law,error_pct]
 
@@ -35,10 +35,15 @@ _SUMMARY = "=================== JOB SUMMARY ================"
 class JobResult:
     """One job of a campaign, read from its log.
 
-    status : 'OK', 'FAILED' (yade-batch's summary), or 'unfinished' (no summary: still
-        running, killed, or a log not written by yade-batch)
-    figures : the job's last JSON object line, or None when it printed none
-    duration_s : from the summary [s], None when unfinished
+    Attributes
+    ----------
+    status : str
+        'OK', 'FAILED' (yade-batch's summary), or 'unfinished' (no summary: still running,
+        killed, or a log not written by yade-batch).
+    figures : dict or None
+        The job's last JSON object line, or None when it printed none.
+    duration_s : float or None
+        From the summary [s], None when unfinished.
     """
     log: str
     job: str

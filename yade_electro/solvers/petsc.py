@@ -6,7 +6,7 @@ its block of rows of the same CSR matrix (PETSc's default ownership: contiguous 
 about n / size rows), PETSc iterates with the ranks working together, and the solution is
 gathered onto every rank, so every rank writes the same values back to its bodies. This
 pays when the solve dominates (large packings, many re-solves); the memory per rank is
-not reduced (see the README's *Scale* section for what a cluster user gets).
+not reduced (see docs/benchmarks.md for what a cluster user gets).
 
 Run standalone with ``mpiexec -n 2 /usr/bin/python3 script.py``, or a YADE script with
 ``mpiexec -n 2 yade-electro -n -x script.py`` (every rank runs the same scene). Without

@@ -66,7 +66,7 @@ __all__ = ["make_solver", "solver_names", "auto_solver_name", "check_solver_name
 log = logging.getLogger(__name__)
 
 #: From this many unknowns on, ``'auto'`` picks ``'cg-deflated'`` (below it, ``'cg'``).
-#: Measured by ``bench/bench_solvers.py`` (see the README's solver table): with its compiled
+#: Measured by ``bench/bench_solvers.py`` (docs/benchmarks.md): with its compiled
 #: iterations the deflated CG is the faster from the smallest rod measured (84 unknowns: cold
 #: solve 1.0 against 1.3 ms, re-solve 0.33 against 0.81 ms); with numpy's it was from about
 #: 2,000 unknowns, the value used before. Below 80 unknowns any solve takes microseconds.

@@ -1,15 +1,16 @@
-"""The engines for ``O.engines``: ``PyRunner``s that read the graph (only what changed), bring
-the kept model up to date, write results back to the bodies and append a history row.
+"""The electrical engine for ``O.engines``: a ``PyRunner`` that reads the graph (only what
+changed), brings the kept model up to date, writes results back to the bodies and appends a
+history row (:class:`ElectricalEngine`; the heat engines build on it).
 
 Example (in a YADE script)::
 
     from yade import pack
-    from yade_electro.yade import ElectricalEngine
+    from yade_electro.yade import ElectricalEngine, Electrode, Material, Output
     electro = ElectricalEngine(
-        resistivity=0.73e-6,
-        electrodes={"top": dict(select=pack.inAlignedBox((-1, -1, 4.9e-3), (1, 1, 1)), potential=1.0),
-                    "bottom": dict(select=pack.inAlignedBox((-1, -1, -1), (1, 1, 0.1e-3)), potential=0.0)},
-        iterPeriod=100, history="electro.csv")
+        material=Material(resistivity=0.73e-6),
+        boundaries=[Electrode("top", select=pack.inAlignedBox((-1, -1, 4.9e-3), (1, 1, 1)), potential=1.0),
+                    Electrode("bottom", select=pack.inAlignedBox((-1, -1, -1), (1, 1, 0.1e-3)), potential=0.0)],
+        output=Output(history="electro.csv"), iterPeriod=100)
     O.engines = O.engines + [electro.runner]
     O.run(1000, True)
     print(electro.equivalent_resistance, electro.potential_by_id[0])
@@ -17,7 +18,7 @@ Example (in a YADE script)::
 Electrode selectors: YADE predicates (selection by element centre), lists of body ids,
 boolean masks, or callables ``f(pos, radius) -> mask``; ``dict(mask=m)`` selects the bodies
 with ``b.mask & m``. The elements are selected once, when the engine is built, and kept by
-body id (``reselect=True`` selects again on each new structure).
+body id (``Reader(reselect=True)`` selects again on each new structure).
 
 Everything is checked when the engine is built, in the user's script, with the real
 exception type (YADE reports errors inside ``O.run`` only as ``PyRunner error``).
@@ -130,14 +131,15 @@ class ElectricalEngine(EngineBase):
         granular = self._options_bonds == "contacts"
         if law is None:
             law = "contact" if granular else ("voronoi" if container is not None else "continuum")
-        from ..laws.conductance import is_contact_law as _is_contact_law
+        from ..laws.factors import is_contact_law as _is_contact_law
         is_contact_law = _is_contact_law(law)
         if granular and not is_contact_law:
-            raise ValueError(f"law {law!r} is a law of bonded solids, but bonds='contacts' (a granular bed): use "
-                             "law='contact' or 'liggghts' (conduction through the contact areas)")
+            raise ValueError(f"law {law!r} is a law of bonded solids, but Reader(bonds='contacts') (a granular bed): "
+                             "use law='contact' or 'liggghts' (conduction through the contact areas)")
         if not granular and is_contact_law:
-            raise ValueError(f"law {law!r} conducts through contact overlaps, but bonds='cohesive' (a bonded solid "
-                             "whose bonds do not overlap): use bonds='contacts' for a granular bed, or a solid's law "
+            raise ValueError(f"law {law!r} conducts through contact overlaps, but Reader(bonds='cohesive') (a bonded "
+                             "solid whose bonds do not overlap): use Reader(bonds='contacts') for a granular bed, or a "
+                             "solid's law "
                              "('voronoi', 'continuum')")
         if law == "voronoi" and container is not None:
             law_params["container"] = law_params.get("container") or container

@@ -42,8 +42,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
     ``b.potential``. One history row per call goes to the CSV as the run goes.
 
     Thermal time: by default each call advances by the simulated time elapsed since the
-    previous call (``O.time`` difference) times ``time_scale``; give ``thermal_dt`` to advance
-    by a fixed thermal step per call instead (the heat and mechanics then run on separate
+    previous call (``O.time`` difference) times ``Integrator(time_scale=...)``; give
+    ``Integrator(dt=...)`` to advance by a fixed thermal step per call instead (the heat and mechanics then run on separate
     clocks). Either way the integrator sub-cycles (explicit) or takes the step in one implicit
     solve (theta method), so it is never bound to ``O.dt``.
 
@@ -113,8 +113,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         if not isinstance(overlap, bool):
             raise ValueError(f"overlap must be True or False, got {overlap!r}")
         if overlap and (electrodes is not None or bonds != "contacts"):
-            raise ValueError("overlap=True is for heat-only engines in the granular mode (electrodes=None, "
-                             "bonds='contacts'); leave it False here")
+            raise ValueError("overlap=True is for heat-only engines in the granular mode (no Electrode, "
+                             "Reader(bonds='contacts')); leave it False here")
         self._drop_inflight()                  # a re-attach in place: the old scene's call is void
         self.overlap = overlap
         if overlap and _resume is None:

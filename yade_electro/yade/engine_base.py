@@ -198,8 +198,8 @@ class EngineBase:
                                           periodic=self._heat_only)
         else:
             if self._declared_walls:
-                raise BoundaryConditionError("walls (walls=, or electrodes with wall=) conduct in the granular mode "
-                                             "only (bonds='contacts'): a bonded solid's boundaries are surfaces "
+                raise BoundaryConditionError("walls (Wall, or Electrode(wall=...)) conduct in the granular mode "
+                                             "only (Reader(bonds='contacts')): a bonded solid's boundaries are surfaces "
                                              "(surface=)")
             self._reader = SceneReader(self.O, **opts)
         if history_mode not in ("w", "a", "x"):

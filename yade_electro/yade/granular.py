@@ -12,7 +12,7 @@ YADE's ``Ig2_Sphere_Sphere_ScGeom`` makes real (overlap > 0, detection factor 1)
 ``interactionDetectionFactor`` makes YADE interactions at a distance, which conduct nothing
 here either. Between two lists the engine sees a change of values on a kept structure.
 
-Walls: ``walls={name: dict(bodies=ids, ...)}`` names YADE bodies whose shape is ``Wall``,
+Walls: ``Wall(name, bodies=ids, ...)`` names YADE bodies whose shape is ``Wall``,
 ``Box`` or ``Facet`` (a facet mesh such as ``geom.facetCylinder`` given as one wall). Their
 geometry is read at every call (a few Python reads per body) and the spheres touching them
 are found with the same skin (:mod:`yade_electro.geometry.contacts`).

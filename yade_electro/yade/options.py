@@ -114,8 +114,9 @@ class Output:
     Parameters
     ----------
     history : str, optional
-        CSV file written row by row, one row per call (iter, time, R_eq, V_ and I_ per
-        electrode, power, energies, temperatures, ...); ``engine.history`` holds the rows too.
+        CSV file written row by row, one row per call (iter, time, R_eq, ``V_<name>`` and
+        ``I_<name>`` per electrode, power, energies, temperatures, ...); ``engine.history`` holds
+        the rows too.
     history_mode : {'w', 'a', 'x'}
         Replace the file (saying so), append to it, or refuse an existing one.
     write_back : str or None

@@ -1,4 +1,4 @@
-"""The overlapped call of a heat-only granular engine (``overlap=True``): its input as plain
+"""The overlapped call of a heat-only granular engine (``Reader(overlap=True)``): its input as plain
 data, the worker-thread marker, and the check that a core is free for the worker."""
 
 from __future__ import annotations

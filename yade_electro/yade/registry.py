@@ -104,7 +104,7 @@ def check_shared_outputs(engine) -> None:
         p1, p2 = engine.history.path, other.history.path
         if p1 and p2 and os.path.abspath(p1) == os.path.abspath(p2):
             raise ValueError(f"engine {other.label!r} already writes the history file {p1!r}; give this engine "
-                             "another history= path")
+                             "another Output(history=...) path")
         for attr in engine.written_attributes:
             if attr in other.written_attributes:
                 warnings.warn(f"engines {other.label!r} and {engine.label!r} both write b.{attr} on the bodies: the "

@@ -14,7 +14,7 @@ What is read
   sphere-sphere interaction is an edge.
 
 Change detection, and what it costs (measured on the bonded 5,000-element rod, 16,851 bonds)
-------------------------------------------------------------------------------------------
+--------------------------------------------------------------------------------------------
 A full read iterates the bodies and interactions in Python (about 35 ms at 5,000 spheres).
 Every other call compares a *stamp* of YADE's own C++ counters, about 0.6 ms in all:
 
@@ -99,8 +99,8 @@ class SphereBodies(NamedTuple):
 #: why a periodic scene is refused (by the bonded reader, and for electrodes)
 PERIODIC_REFUSAL = (
     "the scene has a periodic cell (O.periodic is True), which yade-electro supports only for heat conduction in "
-    "a granular bed (HeatEngine, or ElectroThermalEngine without electrodes, with bonds='contacts'): the bonded "
-    "reader takes bond lengths from the bodies' positions without the cell's periodic images, so the bonds across "
+    "a granular bed (HeatEngine, or ElectroThermalEngine without electrodes, with Reader(bonds='contacts')): the "
+    "bonded reader takes bond lengths from the bodies' positions without the cell's periodic images, so the bonds across "
     "the cell's faces would get the wrong length, and electrodes are not defined across the images. Run this "
     "packing in a box without periodicity, or cut a piece out of the periodic packing")
 
@@ -387,7 +387,7 @@ class SceneReader:
         self.full_reads += 1
         if self.bonds == "cohesive" and not edges:
             log.warning("no cohesive bond between spheres: every element is isolated "
-                        "(did the bonding step run? use bonds='contacts' for cohesionless packings)")
+                        "(did the bonding step run? use Reader(bonds='contacts') for cohesionless packings)")
 
     def positions(self) -> np.ndarray:
         """Current centres (n, 3) [m] of the graph's elements, by YADE's C++ bulk reader."""

@@ -234,7 +234,7 @@ class BoundaryOfGraph:
             return faces.cells, self.law.reference[1]
         key = graph.ids.tobytes()
         if self._key != key:
-            from .bounded_cells import bounded_cells
+            from .cells import bounded_cells
             self._cells = bounded_cells(graph.pos, graph.radius, self.container)
             self._pos = np.array(graph.pos)
             self._key = key
