@@ -19,11 +19,11 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 PY="${PY:-/usr/bin/python3}"
 
 # Debian packages. python3-setuptools/-wheel: the editable install builds with them
-# (--no-build-isolation, so pip fetches no setuptools from PyPI). g++ and libeigen3-dev:
-# bench/bench_scale.py builds an Eigen ConjugateGradient driver to compare the solves with.
+# (--no-build-isolation, so pip fetches no setuptools from PyPI); it compiles the kernels of
+# yade_electro/native (setup.py) with g++ and Eigen's headers (libeigen3-dev), and the CGAL
+# Delaunay helper of the 'voronoi' law with libcgal-dev (without it, scipy's qhull is used).
+# bench/bench_scale.py also builds an Eigen ConjugateGradient driver to compare the solves with.
 # python3-petsc4py, python3-mpi4py, openmpi-bin: solver='petsc' and runs under mpiexec.
-# libcgal-dev: the Delaunay triangulation of the 'voronoi' law (yade_electro/native, built
-# on first use with g++; scipy's qhull is the fallback).
 DEB_PACKAGES=(
   yade liggghts
   python3-pip python3-setuptools python3-wheel
@@ -134,21 +134,29 @@ if [ "${#to_install[@]}" -gt 0 ]; then
 fi
 
 # ---------------------------------------------------------------- this package, editable
-editable_ok() {  # yade_electro importable from this checkout, without running its code
+editable_ok() {  # yade_electro importable from this checkout, its kernels built from their sources
   "$PY" - "$ROOT" <<'EOF'
-import importlib.util, os, sys
+import glob, importlib.machinery, importlib.util, os, sys
 spec = importlib.util.find_spec("yade_electro")
 root = os.path.realpath(sys.argv[1])
 ok = spec is not None and spec.origin and os.path.realpath(spec.origin).startswith(root + os.sep)
+native = os.path.join(root, "yade_electro", "native")
+suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
+for src in glob.glob(os.path.join(native, "*.cpp")):
+    name = os.path.basename(src)[:-4]
+    built = os.path.join(native, name if name == "delaunay_cgal" else f"_{name}{suffix}")
+    if name == "delaunay_cgal" and not os.path.exists("/usr/include/CGAL/Delaunay_triangulation_3.h"):
+        continue
+    ok = ok and os.path.exists(built) and os.path.getmtime(built) >= os.path.getmtime(src)
 sys.exit(0 if ok else 1)
 EOF
 }
 # from / so that the checkout in the current directory does not count as installed
 # the launcher (console script) comes with the editable install: reinstall when it is missing
 if ! assumed_missing yade-electro && (cd / && PYTHONPATH='' editable_ok) && command -v yade-electro >/dev/null 2>&1; then
-  say "yade-electro: editable install points at $ROOT"
+  say "yade-electro: editable install points at $ROOT, kernels built"
 else
-  say "yade-electro: installing $ROOT (editable) into $PY"
+  say "yade-electro: installing $ROOT (editable, compiling its kernels: about 30 s) into $PY"
   run "${PIP[@]}" --no-deps --no-build-isolation -e "$ROOT" \
     || die "editable install of $ROOT failed"
 fi
@@ -176,8 +184,13 @@ assert 0.0 < u.max() < 0.1, "scikit-fem Poisson solve gave %r" % u.max()
 from yade_electro.solvers.petsc import petsc4py_location
 petsc_dir = petsc4py_location()
 assert petsc_dir, "petsc4py not found (apt-get install python3-petsc4py)"
-# the CGAL Delaunay helper: built now, once, so that the first 'voronoi' run does not wait
+# the compiled kernels and the CGAL Delaunay helper, built by the install
+import glob, os
 from yade_electro.native import cgal_executable
+from yade_electro.native.loader import HERE, library_path
+for src in sorted(glob.glob(os.path.join(HERE, "*.cpp"))):
+    if not src.endswith("delaunay_cgal.cpp"):
+        library_path(os.path.basename(src)[:-4])
 cgal_executable()
 print("[install] ok: numpy %s, scipy %s (Debian); pyamg %s, scikit-fem %s; petsc4py in %s; yade_electro from %s"
       % (numpy.__version__, scipy.__version__, pyamg.__version__, skfem.__version__, petsc_dir,

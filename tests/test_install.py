@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 import numpy
@@ -143,3 +144,28 @@ def test_install_script_plans_a_fresh_machine():
     assert len(pip) == 2 and all("--no-deps" in l and "--break-system-packages" in l
                                  for l in pip), pip
     assert "pyamg==" in pip[0] and "scikit-fem==" in pip[0] and " -e " in pip[1], pip
+
+
+def test_the_kernels_were_built_at_install_and_need_no_compiler(tmp_path):
+    # every compiled kernel is there, and a run with no compiler on the PATH uses them
+    script = tmp_path / "no_compiler.py"
+    script.write_text(textwrap.dedent("""
+        import glob, os, json
+        import numpy as np
+        from yade_electro import native
+        from yade_electro.native.loader import HERE, library_path
+        names = [os.path.basename(p)[:-4] for p in glob.glob(os.path.join(HERE, "*.cpp"))]
+        built = {n: str(library_path(n)) for n in names if n != "delaunay_cgal"}
+        helper = str(native.cgal_executable())
+        rng = np.random.default_rng(1)
+        pts = rng.random((2000, 3))
+        from yade_electro.geometry.tessellation import tessellate
+        t = tessellate(pts, 2000, backend="cgal")
+        print(json.dumps({"built": built, "helper": helper, "ridges": int(t.n_ridges)}))
+    """))
+    env = dict(os.environ, PATH=str(tmp_path))                 # no g++, no cc: nothing to compile with
+    res = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, cwd=str(tmp_path))
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert len(out["built"]) == 9 and out["ridges"] > 0
+    assert all(path.startswith(str(REPO_ROOT)) for path in out["built"].values())

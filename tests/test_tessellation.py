@@ -112,7 +112,7 @@ def test_thread_setting(monkeypatch):
 def test_cgal_and_qhull_give_the_same_faces(monkeypatch, capsys):
     from yade_electro.core import progress
     from yade_electro.native import cgal_executable
-    cgal_executable()                                # built here (make install brings g++ and CGAL)
+    cgal_executable()                                # built at install (make install brings g++ and CGAL)
     pts, n = _cloud(5000, 3)
     capsys.readouterr()
     monkeypatch.setattr(progress, "PROGRESS_EVERY", 0.0)        # the helper's wait shows progress
@@ -142,12 +142,12 @@ def test_backend_setting(monkeypatch):
 
 def test_without_cgal_auto_falls_back_and_cgal_says_why(monkeypatch):
     import yade_electro.native as native
-    monkeypatch.setattr(native, "CGAL_HEADER", native.Path("/nonexistent/CGAL/Delaunay_triangulation_3.h"))
-    monkeypatch.setattr(native, "_CGAL", {})                     # no cached executable
+    from yade_electro.native import loader
+    monkeypatch.setattr(loader, "HERE", native.Path("/nonexistent"))     # as if the helper was not built
     monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "auto")
     assert native.delaunay_backend() == "qhull"
     monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "cgal")
-    with pytest.raises(native.NativeError, match="apt-get install libcgal-dev"):
+    with pytest.raises(native.NativeError, match="helper program 'delaunay_cgal' is not built"):
         native.delaunay_backend()
     pts, n = _cloud(500, 4)
     monkeypatch.setenv("YADE_ELECTRO_DELAUNAY", "auto")

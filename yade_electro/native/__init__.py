@@ -1,24 +1,22 @@
-"""Compiled helpers, built on first use with g++ into ``~/.cache/yade-electro`` (or
-``$XDG_CACHE_HOME/yade-electro``), each with a pure-Python fallback.
+"""Compiled kernels, built when the package is installed (``setup.py``) and loaded with ctypes
+(:mod:`.loader`); a run needs no compiler. Each has a numpy form the tests compare it with.
 
 ``delaunay_cgal``: the 3D Delaunay triangulation by CGAL (Debian's header-only
 ``libcgal-dev``, exact predicates): the cells and their circumcentres. Measured on the lattice
 rod of ``bench/bench_scale.py`` at 1,000,188 points: 8.3 s including the file exchange,
 against about 70 s for scipy's qhull, with the same 6,976,387 cells.
 
-``YADE_ELECTRO_DELAUNAY``: ``auto`` (default: CGAL from 120,000 points on when it builds,
-else qhull), ``cgal`` (an error when it cannot be built) or ``qhull``. Below 120,000
+``YADE_ELECTRO_DELAUNAY``: ``auto`` (default: CGAL from 120,000 points on when the helper was
+built at install, else qhull), ``cgal`` (an error when it was not built) or ``qhull``. Below 120,000
 points qhull stays the default: there CGAL saves only 10-20 % of the bounded cells (the
 clipping at curved walls dominates), and on a lattice (cospherical points) the cell
 volumes from CGAL's triangulation are exact only to 3.4e-12, against 5e-15 from qhull's
-(``cases/slab_transient.py``'s finite-volume check; the cause is not found yet). The build takes about 15 s once; parallel
-processes (yade-batch) build into temporary names and rename, so they never run a half
-written executable.
+(``cases/slab_transient.py``'s finite-volume check; the cause is not found yet).
 
 ``graph_hops``: hop distances on a bond graph for the crack rules of the ``voronoi`` law
 (:func:`hops_linked`), a shared library loaded with ctypes. At 1M elements it answers the
-3-hop test of every Voronoi face in 0.24 s, where the sparse-matrix powers (the fallback
-without g++) took about 10 s and 1 GB.
+3-hop test of every Voronoi face in 0.24 s, where sparse-matrix powers (the numpy form)
+took about 10 s and 1 GB.
 
 ``laplacian_fill``: the values of a condensed Laplacian's unknown block from new edge values
 (:func:`laplacian_fill`, used by :class:`yade_electro.network.condensation.ReducedSystem`), numpy's
@@ -60,7 +58,7 @@ from typing import Optional
 
 import numpy as np
 
-from .build import HERE, NativeError, build as _build, cache_dir, shared_function as _shared_function  # noqa: F401
+from .loader import HERE, NativeError, helper_path, shared_function as _shared_function  # noqa: F401
 
 __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked", "soft_sphere_forces",
            "FireSteps", "DeflatedCG", "NativeError",
@@ -68,25 +66,10 @@ __all__ = ["delaunay_backend", "cgal_delaunay", "cgal_executable", "hops_linked"
            "pair_lengths",
            "continuum_factors", "csr_pattern"]
 
-CGAL_HEADER = Path("/usr/include/CGAL/Delaunay_triangulation_3.h")
-
-
-_CGAL = {}
-
-
 def cgal_executable() -> Path:
-    """The built ``delaunay_cgal`` (raises :class:`NativeError` when it cannot be built)."""
-    if "exe" not in _CGAL:
-        if not CGAL_HEADER.exists():
-            _CGAL["exe"] = NativeError("CGAL headers not found (apt-get install libcgal-dev; `make install` does)")
-        else:
-            try:
-                _CGAL["exe"] = _build(HERE / "delaunay_cgal.cpp", "delaunay_cgal", ["-lgmp", "-lmpfr"])
-            except NativeError as exc:
-                _CGAL["exe"] = exc
-    if isinstance(_CGAL["exe"], Exception):
-        raise _CGAL["exe"]
-    return _CGAL["exe"]
+    """The ``delaunay_cgal`` helper built at install (NativeError when it was not: CGAL's
+    headers were missing then)."""
+    return helper_path("delaunay_cgal")
 
 
 #: ``auto`` uses CGAL from this many points on, qhull below (see module doc)
@@ -184,7 +167,7 @@ def _soft_library():
     import ctypes
     i64, ptr = ctypes.c_int64, ctypes.c_void_p
     return _shared_function("soft_spheres", "soft_sphere_forces", [i64, ptr, ptr, ctypes.c_double, i64, ptr, ptr, ptr, ptr],
-                            i64, flags=["-ffp-contract=off"])
+                            i64)
 
 
 def soft_sphere_forces(x, rho, s: float, pairs):
@@ -239,7 +222,7 @@ class FireSteps:
         i64, ptr, dbl = ctypes.c_int64, ctypes.c_void_p, ctypes.c_double
 
         def load(symbol, argtypes, restype):
-            return _shared_function("fire_steps", symbol, argtypes, restype, flags=["-pthread"])
+            return _shared_function("fire_steps", symbol, argtypes, restype)
         self._forces = load("fire_pair_forces", [i64, ptr, ptr, dbl, i64, ptr, ptr, ptr, i64], i64)
         self._power = load("fire_power", [i64, ptr, ptr, ptr], None)
         self._move = load("fire_move", [i64, ptr, ptr, ptr, dbl, dbl, dbl], None)
@@ -403,8 +386,7 @@ def contact_radii(pos, radius, edges, shift=None, model: str = "geometric"):
     be built."""
     import ctypes
     i64, ptr = ctypes.c_int64, ctypes.c_void_p
-    f = _shared_function("contact_radii", "contact_radii", [i64, ptr, ptr, ptr, ptr, ctypes.c_int, ptr], i64,
-                         flags=["-ffp-contract=off"])
+    f = _shared_function("contact_radii", "contact_radii", [i64, ptr, ptr, ptr, ptr, ctypes.c_int, ptr], i64)
     x = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
     r = np.ascontiguousarray(radius, dtype=np.float64)
     e = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
@@ -424,7 +406,7 @@ def pair_lengths(pos, edges, shift=None):
     many are zero; ``contact_radii.cpp``. Raises :class:`NativeError` when it cannot be built."""
     import ctypes
     i64, ptr = ctypes.c_int64, ctypes.c_void_p
-    f = _shared_function("contact_radii", "pair_lengths", [i64, ptr, ptr, ptr, ptr], i64, flags=["-ffp-contract=off"])
+    f = _shared_function("contact_radii", "pair_lengths", [i64, ptr, ptr, ptr, ptr], i64)
     x = np.ascontiguousarray(pos, dtype=np.float64).reshape(-1, 3)
     e = np.ascontiguousarray(edges, dtype=np.int64).reshape(-1, 2)
     s = None if shift is None else np.ascontiguousarray(shift, dtype=np.float64).reshape(-1, 3)
@@ -491,18 +473,16 @@ EIGEN_INCLUDE = "/usr/include/eigen3"
 class DeflatedCG:
     """The iterations of :class:`yade_electro.solvers.registry.DeflatedCGSolver` compiled
     (``deflated_cg.cpp``: the same deflated CG, coarse matrix factorised by Eigen's
-    SimplicialLLT), for ``n`` unknowns and ``k`` clusters. Raises :class:`NativeError` when it
-    cannot be built (needs g++ and Eigen's headers, ``libeigen3-dev``)."""
+    SimplicialLLT), for ``n`` unknowns and ``k`` clusters. Raises :class:`NativeError` when the
+    kernel was not built at install."""
 
     def __init__(self, n: int, k: int):
         import ctypes
         import weakref
-        if not os.path.isdir(EIGEN_INCLUDE):
-            raise NativeError(f"Eigen's headers are missing ({EIGEN_INCLUDE}: apt-get install libeigen3-dev)")
         i64, ptr, dbl = ctypes.c_int64, ctypes.c_void_p, ctypes.c_double
 
         def load(symbol, argtypes, restype):
-            return _shared_function("deflated_cg", symbol, argtypes, restype, flags=["-O3", f"-I{EIGEN_INCLUDE}"])
+            return _shared_function("deflated_cg", symbol, argtypes, restype)
         create = load("dcg_create", [i64, i64], ptr)
         destroy = load("dcg_destroy", [ptr], None)
         self._pattern = load("dcg_coarse_pattern", [ptr, i64, ptr], None)

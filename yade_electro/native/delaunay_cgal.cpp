@@ -1,6 +1,6 @@
 // Delaunay triangulation of a 3D point set with CGAL (exact predicates, inexact
-// constructions), for yade_electro.tessellation. Built on first use by
-// yade_electro/native/__init__.py (g++, Debian's libcgal-dev).
+// constructions), for yade_electro.geometry.tessellation. Built at install by setup.py
+// (g++, Debian's libcgal-dev).
 //
 //   delaunay_cgal IN OUT N_REAL
 //   IN : int64 n, then n x 3 float64 points

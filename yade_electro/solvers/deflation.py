@@ -40,9 +40,9 @@ class DeflatedCGSolver(CGSolver):
         at 1M unknowns, 37,044 clusters took 10.9 s (8.2 s of setup, 32 iterations) and
         5,082 took 4.0 s (60 iterations); at 500k, 19,074 took 4.1 s and 2,673 took 1.6 s.
     native : bool
-        Run the iterations compiled (:class:`yade_electro.native.DeflatedCG`, built on first
-        use; the coarse matrix then factorised by Eigen's sparse Cholesky) instead of numpy
-        (default True; numpy when it cannot be built). The same algorithm; other rounding.
+        Run the iterations compiled (:class:`yade_electro.native.DeflatedCG`, built at install;
+        the coarse matrix then factorised by Eigen's sparse Cholesky) instead of numpy (default
+        True; numpy when the kernel is not built). The same algorithm; other rounding.
     """
 
     name = "cg-deflated"
