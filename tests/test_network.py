@@ -452,8 +452,8 @@ def test_floating_clusters_warn_and_stay_finite(solver):
     # and node 8 bonded to the chain by a zero conductance only
     edges = [[0, 1], [1, 2], [2, 3], [4, 5], [5, 6], [4, 6], [2, 8]]
     c = [1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 0.0]
-    with pytest.warns(UserWarning, match=r"5 element\(s\) in 3 cluster\(s\) are connected to no "
-                                         "electrode"):
+    with pytest.warns(UserWarning, match=r"5 element\(s\) in 3 part\(s\) are connected to no "
+                                         r"electrode: they carry nothing to the rest and keep a potential of 0 V"):
         sol = solve_potential(9, edges, c, two_electrodes([0], [3], 3.0, 0.0), solver=solver)
     np.testing.assert_array_equal(sol.floating, [0, 0, 0, 0, 1, 1, 1, 1, 1])
     assert np.all(np.isfinite(sol.potential)) and np.all(np.isfinite(sol.branch_current))

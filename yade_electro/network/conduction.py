@@ -37,7 +37,8 @@ Sign conventions
   at that electrode (positive at the high-potential electrode of a resistor).
 
 Connected parts with no electrode, and parts whose only electrodes carry imposed currents
-that are all 0, are floating: their potential is undefined, set to 0 V and flagged in
+that are all 0, are floating (:mod:`yade_electro.network.floating`, the one policy for current
+and heat): their potential is undefined, kept at 0 V and flagged in
 ``PotentialSolution.floating`` (a warning says how many nodes). A part with a non-zero imposed
 current and no fixed-potential electrode has no return path and raises.
 
@@ -47,13 +48,13 @@ from __future__ import annotations
 
 import logging
 import time
-import warnings
 from typing import Mapping, Optional, Sequence
 
 import numpy as np
 import scipy.linalg
 
 from .condensation import ReducedSystem
+from .floating import warn_floating
 from .kirchhoff import Electrode, electrode_value, network_components
 from .records import PotentialSolution
 from ..core.errors import BoundaryConditionError, MaterialError, SolverError
@@ -174,9 +175,7 @@ class ConductionProblem:
         self.floating_structural = exclude
         if nfl:
             ncl = np.unique(node_label[exclude]).size
-            warnings.warn(f"{nfl} element(s) in {ncl} cluster(s) are connected to no electrode: they carry "
-                          "no current and their potential is set to 0 V (see PotentialSolution.floating)",
-                          stacklevel=4)
+            warn_floating(nfl, ncl, "electrode", "a potential of 0 V", stacklevel=5)
         nu = self.system.n_unknowns
         if self.solver is None or isinstance(self._solver_spec, str):
             self.solver = make_solver(self._solver_spec, n_unknowns=nu)

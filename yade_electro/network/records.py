@@ -145,6 +145,9 @@ class SteadyHeat:
     convection_power : heat received from the ambient (negative: lost to it)
     boundary_power : heat received from the fixed temperatures (negative: taken by them)
     iterations, residual : of the linear solve (relative residual)
+    floating : (n,) bool, optional: nodes in parts that reach no fixed temperature and no
+        convection; with no heat put into them they keep their mean temperature
+        (:mod:`yade_electro.network.floating`)
     """
 
     temperature: np.ndarray
@@ -154,6 +157,7 @@ class SteadyHeat:
     boundary_power: float
     iterations: int
     residual: float
+    floating: np.ndarray = None
 
     @property
     def balance_error(self) -> float:

@@ -41,6 +41,7 @@ from ..solvers.base import DirectSolver
 from ..solvers.registry import make_solver
 from .condensation import ReducedSystem
 from .conditions import Convection, FixedTemperature, HeatFlux, boundary_value, resolve_conditions
+from .floating import floating_parts, solve_with_floating
 from .records import HeatStep, SteadyHeat, ThermalState, read_only_copy as _ro
 from .theta import theta_of
 
@@ -513,31 +514,24 @@ class HeatSolver:
         return step
 
     # -- steady state ------------------------------------------------------------------------
-    def _check_sinks(self):
-        """Every connected part of the free nodes must reach a fixed temperature or a
-        convection: else its steady temperature is not defined."""
-        import scipy.sparse.csgraph as csg
-        u = self._u
-        if u.size == 0:
-            return
-        n_parts, label = csg.connected_components(self._Muu, directed=False)
-        sink = np.zeros(n_parts, bool)
-        np.logical_or.at(sink, label, self.h_area[u] > 0)
+    def _floating_unknowns(self, heat_in):
+        """(labels, floating mask) of the unknowns that reach no fixed temperature, no link and
+        no convection, by the policy of :mod:`.floating` (None when every part is anchored)."""
+        anchored = self.h_area[self._u] > 0
         if self._Mud is not None and self._Mud.shape[1]:
-            touches = np.asarray(abs(self._Mud).sum(axis=1)).ravel() > 0
-            np.logical_or.at(sink, label, touches)
-        if not np.all(sink):
-            lost = int(np.sum(~sink[label]))
-            raise ThermalError(
-                f"{lost} element(s) in {int(np.sum(~sink))} connected part(s) reach no fixed temperature and no "
-                "convection: their steady temperature is not defined (any heat put in has nowhere to go). Add a "
-                "FixedTemperature or a Convection there, or integrate in time (advance)")
+            anchored = anchored | (np.asarray(abs(self._Mud).sum(axis=1)).ravel() > 0)
+        return floating_parts(self._Muu, anchored, heat_in, reached="fixed temperature and no convection",
+                              kept="their mean temperature (their heat)", inflow_name="heat (sources or fluxes)",
+                              remedy="Add a FixedTemperature or a Convection there, or integrate in time (advance)",
+                              error=ThermalError, stacklevel=5)
 
     def steady(self, sources=None, apply: bool = True, rtol: float = 1e-12) -> SteadyHeat:
         """The steady temperatures ``M T = s`` with the given ``sources`` [W per node] (plus the
         fluxes, heat sources, convection and fixed temperatures of this solver); they replace
-        the current temperatures when ``apply`` (the clock does not move). Raises ThermalError
-        when some part of the network has no fixed temperature and no convection.
+        the current temperatures when ``apply`` (the clock does not move). A part of the network
+        that reaches no fixed temperature and no convection keeps its mean temperature when no
+        heat goes into it (a warning), and raises ThermalError when some does: the policy of
+        :mod:`yade_electro.network.floating`.
 
         The linear solver is ``'auto'`` (:func:`yade_electro.solvers.registry.auto_solver_name`: the
         deflated CG from 80 unknowns on), kept across calls, to ``rtol`` relative residual."""
@@ -545,15 +539,20 @@ class HeatSolver:
         src = np.zeros(n) if sources is None else np.asarray(sources, dtype=float)
         if src.shape != (n,) or not np.all(np.isfinite(src)):
             raise ThermalError(f"sources must be a finite ({n},) array (W per node)")
-        self._check_sinks()
         u = self._u
+        parts = self._floating_unknowns(src[u] + self.flux_power[u])
         Tg = self._fixed_group_values()
         rhs = src[u] + self.flux_power[u] + self._hAT[u]
         if Tg.size:
             rhs = rhs - self._Mud @ Tg
         T = self._T.copy()
         info = {"iterations": 0, "residual": 0.0}
-        if u.size:
+        if parts is not None:
+            try:
+                T[u], info = solve_with_floating(self._Muu, rhs, T[u], self._Cu, parts, rtol)
+            except (SolverError, RuntimeError, ArithmeticError) as exc:
+                raise ThermalError(f"the steady heat solve failed ({exc}); the temperatures are unchanged") from exc
+        elif u.size:
             if getattr(self, "_steady_solver", None) is None or self._steady_key != id(self.system):
                 self._steady_solver = make_solver("auto", n_unknowns=u.size, rtol=rtol)
                 if self._coords is not None:
@@ -579,11 +578,15 @@ class HeatSolver:
         Tu = T[u]
         boundary = float(np.sum(self.system.group_flux(Tu, Tg))) if self._d.size else 0.0
         boundary += float(np.sum(self._link_GT[u] - self._link_G[u] * Tu))
+        mask = np.zeros(n, bool)
+        if parts is not None:
+            mask[u[parts[1]]] = True
+        mask.setflags(write=False)
         out = SteadyHeat(temperature=_ro(T), source_power=float(np.sum(src[u])),
                          flux_power=float(np.sum(self.flux_power[u])),
                          convection_power=float(np.sum(self._conv_hAT[u] - self._conv_hA[u] * Tu)),
                          boundary_power=boundary, iterations=int(info.get("iterations", 0)),
-                         residual=float(info.get("residual", 0.0)))
+                         residual=float(info.get("residual", 0.0)), floating=mask)
         if apply:
             self._T = T
             self._dT_prev = None
