@@ -183,7 +183,7 @@ def test_floating_cluster_in_the_model():
     node = 3 * LAYER + 0
     keep = ~np.any(g.edges == node, axis=1)
     assert (~keep).sum() == 4
-    with pytest.warns(UserWarning, match=r"1 element\(s\) in 1 cluster\(s\)"):
+    with pytest.warns(UserWarning, match=r"1 element\(s\) in 1 part\(s\) are connected to no electrode"):
         sol = model(solver="direct").solve(g.subgraph(keep))
     assert sol.floating.sum() == 1 and sol.floating[node] and sol.potential[node] == 0.0
 

@@ -6,7 +6,9 @@ from .electrical import ElectrodeSpec, ElectricalModel, electrode_specs
 from .integrator import Integrator
 from .thermal import (heat_capacity, thermal_conductance, diffusion_time_step, edge_joule_power,
                       joule_sources, electrical_power, heat_solver_on_graph, surface_conditions, source_power)
+from .walls import WallContacts
 
 __all__ = ["ElectroThermalModel", "ElectrodeSpec", "ElectricalModel", "electrode_specs", "Integrator",
            "heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power",
-           "joule_sources", "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power"]
+           "joule_sources", "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power",
+           "WallContacts"]

@@ -36,7 +36,6 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..geometry.contacts import new_wall_contacts
 from ..laws.factors import FactorNetwork, make_law
 from .electrical import ElectricalModel
 from ..core.errors import BoundaryConditionError, MaterialError
@@ -49,6 +48,8 @@ from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSou
 from ..network.transient import HeatSolver
 from ..network.theta import theta_of
 from .thermal import diffusion_time_step, heat_capacity, source_power, surface_conditions
+
+from .walls import WallContacts
 
 __all__ = ["ElectroThermalModel"]
 
@@ -166,7 +167,7 @@ class ElectroThermalModel:
                 law_.wall_factor(np.ones(1), np.zeros(1))
             except ValueError as exc:
                 raise BoundaryConditionError(f"walls= given with law {law_.name!r}: {exc}") from None
-        self._wall_contacts = {w.name: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
+        self._wall_contacts = WallContacts([w.name for w in self.walls], what="wall")
         self._walls_applied = None
         if container is None and electrical is not None:
             container = electrical.container
@@ -288,13 +289,8 @@ class ElectroThermalModel:
     def set_wall_contacts(self, name: str, nodes, overlap):
         """The spheres touching wall ``name`` now (node indices of the next step's graph) and
         their overlaps [m] (> 0); applied at the next step."""
-        if name not in self._wall_contacts:
-            raise BoundaryConditionError(f"no wall named {name!r}; have {sorted(self._wall_contacts)}")
-        new = new_wall_contacts(f"wall {name!r}", self._wall_contacts[name], nodes, overlap)
-        if new is None:
-            return                                  # the same contacts: nothing to update
-        self._wall_contacts[name] = new
-        self._walls_applied = None
+        if self._wall_contacts.set(name, nodes, overlap):
+            self._walls_applied = None
 
     def wall_conductances(self, graph: ContactGraph, names=None) -> dict:
         """name -> (nodes, G [W/K]) of each wall's contacts on ``graph`` (adiabatic walls too:
@@ -304,13 +300,11 @@ class ElectroThermalModel:
         for w in self.walls:
             if names is not None and w.name not in names:
                 continue
-            nd, dl = self._wall_contacts[w.name]
-            if nd.size and nd.max() >= graph.n_nodes:
-                raise ValueError(f"wall {w.name!r}: contact node index beyond the graph's {graph.n_nodes} nodes")
+            nd, g = self._wall_contacts.factors(w.name, self.network.law, graph.radius, graph.n_nodes)
             lam_p = lam if lam.ndim == 0 else lam[nd]
             lam_w = lam_p if w.conductivity is None else w.conductivity
             lam_e = 2.0 * lam_p * lam_w / (lam_p + lam_w)
-            out[w.name] = (nd, lam_e * self.network.law.wall_factor(graph.radius[nd], dl))
+            out[w.name] = (nd, lam_e * g)
         return out
 
     def _apply_walls(self, graph, assemble=True) -> bool:
@@ -592,7 +586,7 @@ class ElectroThermalModel:
             for w in self.walls:
                 if not w.isothermal:
                     continue                # adiabatic: nothing to report
-                nd, _ = self._wall_contacts[w.name]
+                nd, _ = self._wall_contacts.contacts(w.name)
                 row[f"wall_contacts:{w.name}"] = int(nd.size)
                 row[f"wall_power:{w.name}"] = flows.get(w.name, 0.0)
                 row[f"wall_heat:{w.name}"] = heat.link_energy.get(w.name, 0.0)

@@ -26,7 +26,6 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..geometry.contacts import new_wall_contacts
 from ..laws.factors import ConductanceLaw, FactorNetwork, make_law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
@@ -36,6 +35,8 @@ from ..network.records import PotentialSolution
 from ..network.kirchhoff import Electrode, electrode_value
 from ..core.selection import Membership, Selector, check_selector, select_nodes
 from ..solvers.registry import check_solver_name
+
+from .walls import WallContacts
 
 __all__ = ["ElectrodeSpec", "ElectricalModel", "electrode_specs"]
 
@@ -177,7 +178,7 @@ class ElectricalModel:
                 self.law.wall_factor(np.ones(1), np.zeros(1))
             except ValueError as exc:
                 raise BoundaryConditionError(f"wall electrodes {self.walls} with law {self.law.name!r}: {exc}") from None
-        self._wall_contacts = {w: (np.zeros(0, dtype=np.int64), np.zeros(0)) for w in self.walls}
+        self._wall_contacts = WallContacts(self.walls, what="wall electrode")
         self._wall_nodes = {}                 # name -> the nodes of its edges in the kept problem
         self._walls_stale = False
         self.container = container if container is not None else getattr(self.law, "container", None)
@@ -296,17 +297,12 @@ class ElectricalModel:
         their overlaps [m] (> 0). Particles that touched it before keep their edge with a zero
         conductance (the structure is kept); a particle touching it for the first time makes a
         new structure."""
-        if name not in self._wall_contacts:
-            raise BoundaryConditionError(f"no wall electrode named {name!r}; have {self.walls}")
-        new = new_wall_contacts(f"wall electrode {name!r}", self._wall_contacts[name], nodes, overlap)
-        if new is None:
-            return                                  # the same contacts: nothing to update
-        self._wall_contacts[name] = new
-        self._walls_stale = True
+        if self._wall_contacts.set(name, nodes, overlap):
+            self._walls_stale = True
 
     def _wall_factor(self, name, graph, nodes):
         """Factors g [m] of the kept edges ``nodes`` of wall ``name`` for its current contacts."""
-        nd, dl = self._wall_contacts[name]
+        nd, dl = self._wall_contacts.contacts(name)
         over = np.zeros(nodes.size)
         if nd.size:
             pos = np.searchsorted(nodes, nd)
@@ -315,7 +311,8 @@ class ElectricalModel:
 
     def _walls_fit(self) -> bool:
         """True when every particle touching a wall electrode has an edge to it."""
-        for name, (nd, _) in self._wall_contacts.items():
+        for name in self._wall_contacts.names:
+            nd, _ = self._wall_contacts.contacts(name)
             kept = self._wall_nodes.get(name)
             if kept is None or (nd.size and not np.all(np.isin(nd, kept))):
                 return False
@@ -330,7 +327,7 @@ class ElectricalModel:
         electrodes, surf_edges, surf_g, surf_nodes = [], [], [], []
         for s in self.specs:
             if s.wall:
-                nd, _ = self._wall_contacts[s.name]
+                nd, _ = self._wall_contacts.contacts(s.name)
                 if nd.size == 0:
                     raise BoundaryConditionError(
                         f"wall electrode {s.name!r} touches no particle: no current can enter there (is the bed "
