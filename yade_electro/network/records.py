@@ -140,14 +140,21 @@ class HeatStep:
 class SteadyHeat:
     """A steady temperature field (:meth:`HeatSolver.steady`); powers in W.
 
-    temperature : (n,) [K]
-    source_power, flux_power : the given sources and the imposed fluxes / heat sources on free nodes
-    convection_power : heat received from the ambient (negative: lost to it)
-    boundary_power : heat received from the fixed temperatures (negative: taken by them)
-    iterations, residual : of the linear solve (relative residual)
-    floating : (n,) bool, optional: nodes in parts that reach no fixed temperature and no
-        convection; with no heat put into them they keep their mean temperature
-        (:mod:`yade_electro.network.floating`)
+    Attributes
+    ----------
+    temperature : (n,) array
+        Temperatures [K].
+    source_power, flux_power : float
+        The given sources, and the imposed fluxes and heat sources, on free nodes [W].
+    convection_power : float
+        Heat received from the ambient [W] (negative: lost to it).
+    boundary_power : float
+        Heat received from the fixed temperatures [W] (negative: taken by them).
+    iterations, residual : int, float
+        Of the linear solve (relative residual).
+    floating : (n,) bool array
+        Nodes in parts that reach no fixed temperature and no convection: with no heat put
+        into them they keep their mean temperature (:mod:`yade_electro.network.floating`).
     """
 
     temperature: np.ndarray
