@@ -25,7 +25,8 @@ import numpy as np
 
 from .errors import MaterialError
 
-__all__ = ["Material", "positive_property", "real_number", "edge_resistivity", "edge_conductivity"]
+__all__ = ["Material", "positive_property", "real_number", "edge_resistivity", "edge_conductivity",
+           "electrical_conductance", "thermal_conductance_of"]
 
 
 def real_number(name: str, value, *, what: str = "a real number") -> float:
@@ -76,6 +77,20 @@ def edge_conductivity(lam, edges) -> np.ndarray:
         return np.full(edges.shape[0], float(lam))
     a, b = lam[edges[:, 0]], lam[edges[:, 1]]
     return 2.0 * a * b / (a + b)
+
+
+def electrical_conductance(factor, resistivity, edges) -> np.ndarray:
+    """Electrical conductance of each edge [S]: its geometric factor ``factor`` [m] over the
+    edge's resistivity [ohm m] (:func:`edge_resistivity`). The one place where a factor meets
+    a resistivity."""
+    return np.asarray(factor, dtype=float) / edge_resistivity(resistivity, edges)
+
+
+def thermal_conductance_of(factor, conductivity, edges) -> np.ndarray:
+    """Thermal conductance of each edge [W/K]: the edge's conductivity [W/(m K)]
+    (:func:`edge_conductivity`) times its geometric factor ``factor`` [m]. The one place where
+    a factor meets a conductivity."""
+    return edge_conductivity(conductivity, edges) * np.asarray(factor, dtype=float)
 
 
 @dataclass(frozen=True, eq=False)

@@ -52,7 +52,7 @@ import numpy as np
 from ..geometry.contacts import native_helper
 from ..core.errors import MaterialError
 from ..core.graph import ContactGraph
-from ..core.materials import edge_resistivity, positive_property
+from ..core.materials import electrical_conductance, positive_property
 from .transmission import edge_transmission_surface, polyhedron_alpha
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
@@ -452,7 +452,7 @@ def conductance(graph: ContactGraph, resistivity, law="continuum", **params) -> 
     law = make_law(law, **params)
     rho = positive_property("resistivity", resistivity, graph.n_nodes, " (ohm m for electrical resistivity)")
     g = law.factor(graph, graph.edges)
-    c = g / edge_resistivity(rho, graph.edges)
+    c = electrical_conductance(g, rho, graph.edges)
     if not np.all(np.isfinite(c)) or np.any(c < 0):
         raise MaterialError(f"conductance law {law.name!r} produced non-finite or negative values")
     return c

@@ -37,8 +37,10 @@ class Law:
 
     Raises
     ------
-    ValueError
+    KeyError
         An unknown law name (the message lists the known ones).
+    ValueError
+        A name that is not a string, or the container given twice.
     """
 
     __slots__ = ("name", "container", "volume_fraction", "params")

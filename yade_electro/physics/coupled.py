@@ -41,7 +41,7 @@ from .electrical import ElectricalModel
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
 from ..core.history import History
-from ..core.materials import Material, edge_conductivity, real_number
+from ..core.materials import Material, real_number, thermal_conductance_of
 from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
 from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
@@ -239,7 +239,7 @@ class ElectroThermalModel:
 
     def _thermal_conductance(self, graph):
         lam = self.material.conductivity
-        return edge_conductivity(lam, self.network.edges) * self.network.factor
+        return thermal_conductance_of(self.network.factor, lam, self.network.edges)
 
     def prepare(self, graph: ContactGraph):
         """Bring both models to ``graph`` (see the module doc). Heat that the change of the

@@ -29,7 +29,7 @@ import numpy as np
 from ..laws.factors import ConductanceLaw, FactorNetwork, make_law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
-from ..core.materials import Material, edge_resistivity, positive_property
+from ..core.materials import Material, electrical_conductance, positive_property
 from ..network.conduction import ConductionProblem
 from ..network.records import PotentialSolution
 from ..network.kirchhoff import Electrode, electrode_value
@@ -261,7 +261,7 @@ class ElectricalModel:
     def _full_conductance(self, n):
         """Conductances [S] of the problem's edges: the law's network (g / rho_edge), then the
         surface electrodes' half cells (g / rho of the element)."""
-        c = self.network.factor / self._rho_edge(self.network.edges, n)
+        c = electrical_conductance(self.network.factor, self._resistivity_of(n), self.network.edges)
         if self._surface_edges.size:
             rho = np.asarray(self.resistivity, float)
             rho_i = rho if rho.ndim == 0 else rho[self._surface_edges[:, 0]]
@@ -286,11 +286,12 @@ class ElectricalModel:
             out += np.bincount(self._surface_edges[:, 0], p[m:], n)
         return out
 
-    def _rho_edge(self, edges, n):
+    def _resistivity_of(self, n):
+        """The resistivity [ohm m], checked against the ``n`` elements when it is per element."""
         rho = self.resistivity
         if np.ndim(rho) == 1 and np.shape(rho)[0] != n:
             raise BoundaryConditionError(f"resistivity has {np.shape(rho)[0]} values but the packing has {n} elements")
-        return edge_resistivity(rho, edges)
+        return rho
 
     def set_wall_contacts(self, name: str, nodes, overlap):
         """The particles touching wall electrode ``name`` (node indices of the next graph) and

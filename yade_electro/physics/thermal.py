@@ -27,7 +27,7 @@ from typing import Optional
 import numpy as np
 
 from ..core.graph import ContactGraph
-from ..core.materials import edge_conductivity, positive_property
+from ..core.materials import positive_property, thermal_conductance_of
 from ..laws.factors import make_law
 from ..laws.transmission import volume_fraction as _volume_fraction
 from ..network.kirchhoff import edge_power
@@ -92,7 +92,7 @@ def thermal_conductance(graph: ContactGraph, conductivity, law="continuum", **pa
         A non-positive or non-finite conductivity [W/(m K)].
     """
     lam = positive_property("thermal conductivity", conductivity, graph.n_nodes, " (W/(m K))")
-    return edge_conductivity(lam, graph.edges) * make_law(law, **params).factor(graph, graph.edges)
+    return thermal_conductance_of(make_law(law, **params).factor(graph, graph.edges), lam, graph.edges)
 
 
 def diffusion_time_step(graph: ContactGraph, conductivity, density, specific_heat) -> float:
