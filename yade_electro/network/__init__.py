@@ -4,7 +4,7 @@ steady solves and the energy ledger. Never imports YADE.
 """
 from .condensation import ReducedSystem
 from .conditions import (FixedTemperature, ThermalWall, HeatFlux, Convection, HeatSource, resolve_nodes,
-                         resolve_area, ResolvedConditions, resolve_conditions)
+                         resolve_area, ResolvedConditions, resolve_conditions, check_place)
 from .conduction import ConductionProblem, solve_potential, equivalent_resistance
 from .floating import (floating_message, warn_floating, no_steady_state_message, floating_parts,
                        hold_at_mean, solve_with_floating)
@@ -14,9 +14,9 @@ from .theta import theta_of, stable_time_step, THETA_NAMES
 from .transient import HeatSolver
 
 __all__ = ["ReducedSystem", "FixedTemperature", "ThermalWall", "HeatFlux", "Convection", "HeatSource",
-           "resolve_nodes", "resolve_area", "ResolvedConditions", "resolve_conditions", "ConductionProblem",
-           "solve_potential", "equivalent_resistance", "floating_message", "warn_floating",
-           "no_steady_state_message", "floating_parts", "hold_at_mean", "solve_with_floating", "laplacian",
-           "network_components", "electrode_value", "edge_power", "Electrode", "PotentialSolution",
-           "ThermalState", "HeatStep", "SteadyHeat", "read_only_copy", "theta_of", "stable_time_step",
-           "THETA_NAMES", "HeatSolver"]
+           "resolve_nodes", "resolve_area", "ResolvedConditions", "resolve_conditions", "check_place",
+           "ConductionProblem", "solve_potential", "equivalent_resistance", "floating_message",
+           "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",
+           "solve_with_floating", "laplacian", "network_components", "electrode_value", "edge_power",
+           "Electrode", "PotentialSolution", "ThermalState", "HeatStep", "SteadyHeat", "read_only_copy",
+           "theta_of", "stable_time_step", "THETA_NAMES", "HeatSolver"]

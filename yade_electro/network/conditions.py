@@ -16,7 +16,8 @@ from ..core.materials import real_number
 from ..core.selection import check_selector, select_nodes
 
 __all__ = ["FixedTemperature", "ThermalWall", "HeatFlux", "Convection", "HeatSource", "resolve_nodes",
-           "resolve_area", "ResolvedConditions", "resolve_conditions"]
+           "resolve_area", "ResolvedConditions", "resolve_conditions",
+           "check_place"]
 
 
 def boundary_value(name, v) -> float:
@@ -27,24 +28,34 @@ def boundary_value(name, v) -> float:
         raise BoundaryConditionError(str(exc)) from None
 
 
-def _check_bc(bc, kind):
-    if not isinstance(bc.name, str) or not bc.name:
-        raise BoundaryConditionError(f"{kind} boundary condition names must be non-empty strings, got {bc.name!r}")
-    surface = getattr(bc, "surface", None)
+def check_place(what: str, name, *, elements=None, surface=None, wall=False, elements_key: str = "nodes",
+                allow_wall: bool = False) -> None:
+    """Check where a condition acts, the one check for electrodes and thermal conditions: a
+    non-empty ``name`` and exactly one place, elements (``elements_key=``, a selector), a
+    ``surface`` of the container, or (``allow_wall``) a wall of a granular bed; the surface and
+    the selector are checked too. BoundaryConditionError saying what to give."""
+    if not isinstance(name, str) or not name:
+        raise BoundaryConditionError(f"{what} names must be non-empty strings, got {name!r}")
+    options = (f"{elements_key}= (elements: a predicate, ids or a mask) or surface= (a surface of the container)"
+               + (" or wall= (a wall of a granular bed)" if allow_wall else ""))
+    given = (elements is not None) + (surface is not None) + bool(wall)
+    if given != 1:
+        raise BoundaryConditionError(f"{what} {name!r}: give {options}" + (", not both" if given > 1 else ""))
     if surface is not None:
-        if bc.nodes is not None:
-            raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (elements) or surface= "
-                                         "(a surface of the container), not both")
+        from ..geometry.boundary import check_surface
+        check_surface(surface, f"{what} {name!r}")
+    elif elements is not None:
+        check_selector(elements, f"{what} {name!r}: {elements_key}")
+
+
+def _check_bc(bc, kind):
+    surface = getattr(bc, "surface", None)
+    check_place(f"{kind} boundary condition", bc.name, elements=bc.nodes, surface=surface)
+    if surface is not None:
         if getattr(bc, "area", None) is not None:
             raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: a surface condition takes its areas "
                                          "from the boundary faces on the surface; do not give area=")
-        from ..geometry.boundary import check_surface
-        check_surface(surface, f"{kind} boundary condition {bc.name!r}")
         return
-    if bc.nodes is None:
-        raise BoundaryConditionError(f"{kind} boundary condition {bc.name!r}: give nodes= (a selector: predicate, "
-                                     "ids, mask) or surface= (a surface of the container)")
-    check_selector(bc.nodes, f"{kind} boundary condition {bc.name!r}: nodes")
     area = getattr(bc, "area", None)
     if area is not None and not callable(area):
         try:

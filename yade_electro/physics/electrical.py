@@ -33,10 +33,12 @@ from ..core.materials import Material, electrical_conductance, positive_property
 from ..network.conduction import ConductionProblem
 from ..network.records import PotentialSolution
 from ..network.kirchhoff import Electrode, electrode_value
-from ..core.selection import Membership, Selector, check_selector, select_nodes
+from ..core.selection import Membership, Selector, select_nodes
 from ..solvers.registry import check_solver_name
 
 from .walls import WallContacts
+
+from ..network.conditions import check_place
 
 __all__ = ["ElectrodeSpec", "ElectricalModel", "electrode_specs"]
 
@@ -65,19 +67,10 @@ class ElectrodeSpec:
     wall: bool = False
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise BoundaryConditionError(f"electrode names must be non-empty strings, got {self.name!r}")
         if not isinstance(self.wall, bool):
             raise BoundaryConditionError(f"electrode {self.name!r}: wall= must be True or False")
-        if (self.select is not None) + (self.surface is not None) + self.wall != 1:
-            raise BoundaryConditionError(f"electrode {self.name!r}: give select= (an element layer: a predicate, ids "
-                                         "or a mask), surface= (a surface of the container) or wall= (a wall of a "
-                                         "granular bed), one of them")
-        if self.surface is not None:
-            from ..geometry.boundary import check_surface
-            check_surface(self.surface, f"electrode {self.name!r}")
-        elif not self.wall:
-            check_selector(self.select, f"electrode {self.name!r}: select")
+        check_place("electrode", self.name, elements=self.select, surface=self.surface, wall=self.wall,
+                    elements_key="select", allow_wall=True)
         if (self.potential is None) == (self.current is None):
             raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
                                          "(fixed potential, V) or current= (imposed current, A)")
