@@ -8,7 +8,8 @@ from .conditions import (FixedTemperature, ThermalWall, HeatFlux, Convection, He
 from .conduction import ConductionProblem, solve_potential, equivalent_resistance
 from .floating import (floating_message, warn_floating, no_steady_state_message, floating_parts,
                        hold_at_mean, solve_with_floating)
-from .kirchhoff import laplacian, network_components, electrode_value, edge_power, Electrode
+from .kirchhoff import (laplacian, network_components, electrode_value, edge_power, PotentialOrCurrent,
+                        Electrode)
 from .records import PotentialSolution, ThermalState, HeatStep, SteadyHeat, read_only_copy
 from .theta import theta_of, stable_time_step, THETA_NAMES
 from .transient import HeatSolver
@@ -18,5 +19,5 @@ __all__ = ["ReducedSystem", "FixedTemperature", "ThermalWall", "HeatFlux", "Conv
            "ConductionProblem", "solve_potential", "equivalent_resistance", "floating_message",
            "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",
            "solve_with_floating", "laplacian", "network_components", "electrode_value", "edge_power",
-           "Electrode", "PotentialSolution", "ThermalState", "HeatStep", "SteadyHeat", "read_only_copy",
-           "theta_of", "stable_time_step", "THETA_NAMES", "HeatSolver"]
+           "PotentialOrCurrent", "Electrode", "PotentialSolution", "ThermalState", "HeatStep", "SteadyHeat",
+           "read_only_copy", "theta_of", "stable_time_step", "THETA_NAMES", "HeatSolver"]

@@ -14,7 +14,8 @@ from scipy.sparse.csgraph import connected_components
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.materials import real_number
 
-__all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "Electrode"]
+__all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "PotentialOrCurrent",
+           "Electrode"]
 
 
 def laplacian(edges, conductance, n_nodes: int) -> sp.csr_matrix:
@@ -64,8 +65,31 @@ def edge_power(branch_current, conductance) -> np.ndarray:
     return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
 
 
+class PotentialOrCurrent:
+    """What an electrode imposes, the same for every kind of electrode: a fixed ``potential``
+    [V] or an imposed ``current`` [A] fed into the network, exactly one, a finite real number
+    (checked by :meth:`check_value` in the subclass's ``__post_init__``)."""
+
+    def check_value(self):
+        if (self.potential is None) == (self.current is None):
+            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
+                                         "(fixed potential, V) or current= (imposed current, A)")
+        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
+        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
+
+    @property
+    def fixed(self) -> bool:
+        """True for a fixed potential, False for an imposed current."""
+        return self.potential is not None
+
+    @property
+    def value(self) -> float:
+        """The potential [V] or the current [A]."""
+        return float(self.potential if self.fixed else self.current)
+
+
 @dataclass(frozen=True)
-class Electrode:
+class Electrode(PotentialOrCurrent):
     """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current.
 
     Parameters
@@ -94,18 +118,6 @@ class Electrode:
         if nodes.size == 0:
             raise BoundaryConditionError(f"electrode {self.name!r} selects no element: check its "
                                          "predicate/box, ids or mask against the packing")
-        if (self.potential is None) == (self.current is None):
-            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
-                                         "(fixed potential, V) or current= (imposed current, A)")
-        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
-        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
+        self.check_value()
         nodes.setflags(write=False)
         object.__setattr__(self, "nodes", nodes)
-
-    @property
-    def fixed(self) -> bool:
-        return self.potential is not None
-
-    @property
-    def value(self) -> float:
-        return float(self.potential if self.fixed else self.current)

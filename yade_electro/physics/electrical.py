@@ -32,7 +32,7 @@ from ..core.graph import ContactGraph
 from ..core.materials import Material, electrical_conductance, positive_property
 from ..network.conduction import ConductionProblem
 from ..network.records import PotentialSolution
-from ..network.kirchhoff import Electrode, electrode_value
+from ..network.kirchhoff import Electrode, PotentialOrCurrent, electrode_value
 from ..core.selection import Membership, Selector, select_nodes
 from ..solvers.registry import check_solver_name
 
@@ -46,7 +46,7 @@ log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
-class ElectrodeSpec:
+class ElectrodeSpec(PotentialOrCurrent):
     """An electrode to be resolved on a graph: where it is, and a fixed potential [V] or an
     imposed current [A] (exactly one), checked at construction.
 
@@ -71,19 +71,7 @@ class ElectrodeSpec:
             raise BoundaryConditionError(f"electrode {self.name!r}: wall= must be True or False")
         check_place("electrode", self.name, elements=self.select, surface=self.surface, wall=self.wall,
                     elements_key="select", allow_wall=True)
-        if (self.potential is None) == (self.current is None):
-            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
-                                         "(fixed potential, V) or current= (imposed current, A)")
-        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
-        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
-
-    @property
-    def fixed(self) -> bool:
-        return self.potential is not None
-
-    @property
-    def value(self) -> float:
-        return float(self.potential if self.fixed else self.current)
+        self.check_value()
 
     def resolve(self, graph: ContactGraph) -> Electrode:
         if self.surface is not None or self.wall:
