@@ -43,7 +43,7 @@ def bench(n=5000, seed=1, laws=("voronoi", "continuum"), periods=(1, 100), block
             eng = ElectricalEngine(
                 material=Material(resistivity=PT.RESISTIVITY),
                 boundaries=electrodes_from_dict(el),
-                law=Law(law, **(params or {}), container=cyl),
+                law=Law(law, **{**(params or {}), "container": cyl}),
                 reader=Reader(bond_check="flags"),
                 output=Output(write_back=None),
                 iterPeriod=period,
