@@ -68,7 +68,7 @@ def bench_size(n, repeat=5, seed=1):
         el = ElectricalModel(rod.RHO_304L, electrodes, law=law,
                              law_params={"container": container} if law == "voronoi" else None)
         return ElectroThermalModel(el, jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, beta=beta,
-                                   theta=theta)
+                                   integrator=Integrator(theta=theta))
 
     for law in ("continuum", "voronoi"):
         suffix = "" if law == "continuum" else "_voronoi"   # put before "_ms": to_ms converts "*_ms"

@@ -10,6 +10,7 @@ from yade_electro.geometry.contacts import (WallGeometry, candidate_pairs, plane
                                    wall_candidates, wall_overlaps)
 from yade_electro.laws.factors import make_law
 from yade_electro.physics.coupled import ElectroThermalModel
+from yade_electro.physics.integrator import Integrator
 from yade_electro.core.errors import BoundaryConditionError
 from yade_electro.core.graph import ContactGraph
 from yade_electro.network.conditions import ThermalWall
@@ -206,7 +207,7 @@ def test_softened_stiffness_correction(correction, k):
 def _sphere_on_hot_plane(theta, dt, steps, wall_conductivity=None):
     r, k, rho, c = 2e-3, 385.0, 8900.0, 172.0
     g = ContactGraph(np.zeros((1, 3)), [r], np.zeros((0, 2)))
-    m = ElectroThermalModel(None, rho, c, k, 0.0, law="contact", volume_fraction=1.0, theta=theta,
+    m = ElectroThermalModel(None, rho, c, k, 0.0, law="contact", volume_fraction=1.0, integrator=Integrator(theta=theta),
                             walls=[ThermalWall("plate", 100.0, wall_conductivity), ThermalWall("lid")])
     dl = 0.1e-3
     m.set_wall_contacts("plate", [0], [dl])

@@ -20,6 +20,7 @@ import pytest
 from yade_electro import ContactGraph, MaterialError, ThermalError, solve_potential
 from yade_electro.laws.factors import conductance
 from yade_electro.physics.coupled import ElectroThermalModel
+from yade_electro.physics.integrator import Integrator
 from yade_electro.physics.electrical import ElectricalModel
 from yade_electro.core.history import History
 from yade_electro.core.errors import BoundaryConditionError
@@ -303,7 +304,7 @@ def test_adiabatic_joule_heating_of_a_bar(theta, tmp_path):
     g = rod()
     V = 1e-3
     hist = History(str(tmp_path / "h.csv"))
-    m = ElectroThermalModel(electrical(potential=V), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, theta=theta,
+    m = ElectroThermalModel(electrical(potential=V), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, integrator=Integrator(theta=theta),
                             history=hist)
     dt = 2e-3
     for _ in range(10):
@@ -374,8 +375,8 @@ def _resistor_model(beta, iterations, **drive):
     g = pair()
     el = ElectricalModel(RHO_E, {"a": dict(select=[0], **drive), "b": dict(select=[1], potential=0.0)},
                          solver="direct")
-    m = ElectroThermalModel(el, DENSITY, SPECIFIC_HEAT, LAMBDA, 300.0, beta=beta, coupling_iterations=iterations,
-                            theta="backward-euler")
+    m = ElectroThermalModel(el, DENSITY, SPECIFIC_HEAT, LAMBDA, 300.0, beta=beta,
+                            integrator=Integrator(theta="backward-euler", coupling_iterations=iterations))
     R0 = 1.0 / conductance(g, RHO_E)[0]
     C_tot = heat_capacity(g, DENSITY, SPECIFIC_HEAT).sum()
     return g, m, R0, C_tot
@@ -534,7 +535,7 @@ def test_solver_setup_is_kept_while_dt_is_unchanged():
 
 def test_coupled_time_step_figures():
     g = rod()
-    m = ElectroThermalModel(electrical(), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, theta="explicit")
+    m = ElectroThermalModel(electrical(), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, integrator=Integrator(theta="explicit"))
     m.step(g, 1e-4)
     ts = m.time_steps()
     assert ts["allowed"] == pytest.approx(0.9 * ts["critical"])

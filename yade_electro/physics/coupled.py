@@ -21,9 +21,9 @@ One owner each: the thermal clock and the energy ledger are the heat solver's (`
 ``energy``), the electrode values the electrical model's (``set_electrode``).
 
 Coupling in time: the sources of a step are computed with the resistivity at the start of
-the step (lagged, first order); ``coupling_iterations = k > 0`` re-solves the potential up to
-k times with the resistivity at the mid-step temperature ``(T^n + T^{n+1})/2`` (fixed-point
-iterations, second order in dt), stopping when the sources change by less than
+the step (lagged, first order); ``Integrator(coupling_iterations=k)``, k > 0, re-solves the
+potential up to k times with the resistivity at the mid-step temperature ``(T^n + T^{n+1})/2``
+(fixed-point iterations, second order in dt), stopping when the sources change by less than
 ``coupling_tol`` (relative).
 
 Units: SI; temperatures in K (or degC if T_0 and every temperature are in degC).
@@ -46,10 +46,11 @@ from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
 from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
 from ..network.transient import HeatSolver
-from ..network.theta import theta_of
 from .thermal import diffusion_time_step, heat_capacity, source_power, surface_conditions
 
 from .walls import WallContacts
+
+from .integrator import Integrator
 
 __all__ = ["ElectroThermalModel"]
 
@@ -74,13 +75,11 @@ class ElectroThermalModel:
         T_0 of rho_e(T) and of ``heat_content``; default ``temperature``.
     beta : float
         Temperature coefficient of the resistivity [1/K] (0: constant resistivity).
-    eta : float in [0, 1]
-        Share of the electrical power released as heat (paper 000 eq. 11).
-    theta : float or name
-        'explicit' (sub-cycled to the stable step), 'crank-nicolson', 'backward-euler'
-        (default) or a number in [0, 1].
-    subcycle, safety, max_substeps, thermal_solver :
-        Passed to :class:`HeatSolver` (``thermal_solver`` is its ``solver``).
+    integrator : Integrator
+        The theta method, sub-cycling, safety, the heat step's linear solver, ``eta`` (the share
+        of the electrical power released as heat, paper 000 eq. 11) and the coupling to rho_e(T)
+        (:class:`~yade_electro.physics.integrator.Integrator`; its ``dt``, ``time_scale`` and
+        ``steady`` are the engines' per-call settings).
     fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
         Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
         on the first graph and then kept by element id; or ``surface=`` a surface of the
@@ -96,7 +95,6 @@ class ElectroThermalModel:
     volume_fraction, cell_volume : optional, see :func:`~yade_electro.network.transient.heat_capacity`
         Scalars or callables ``f(graph) -> (n,)``. Default: paper 000's fv(n) capacities,
         except with the 'voronoi' law, where its bounded Voronoi cell volumes are used.
-    coupling_iterations, coupling_tol, resistivity_tol : see the module notes.
     law, law_params : conductance law of the heat-only model (``electrical=None``).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
@@ -108,12 +106,11 @@ class ElectroThermalModel:
 
     def __init__(self, electrical: Optional[ElectricalModel], density, specific_heat, conductivity,
                  temperature: float, *, reference_temperature: Optional[float] = None, beta: float = 0.0,
-                 eta: float = 1.0, theta="backward-euler", subcycle: bool = True, safety: float = 0.9,
-                 max_substeps: int = 100000, thermal_solver="cg", fixed: Sequence[FixedTemperature] = (),
+                 integrator: Integrator = Integrator(), fixed: Sequence[FixedTemperature] = (),
                  flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), area=None,
-                 volume_fraction=None, cell_volume=None, coupling_iterations: int = 0, coupling_tol: float = 1e-10,
-                 resistivity_tol: float = 0.0, law="continuum", law_params: Optional[dict] = None, history=None,
-                 sources: Sequence[HeatSource] = (), container=None, walls: Sequence[ThermalWall] = ()):
+                 volume_fraction=None, cell_volume=None, law="continuum", law_params: Optional[dict] = None,
+                 history=None, sources: Sequence[HeatSource] = (), container=None,
+                 walls: Sequence[ThermalWall] = ()):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.physics.electrical) or None")
         self.electrical = electrical
@@ -126,12 +123,13 @@ class ElectroThermalModel:
             raise MaterialError("beta (rho_e(T)) needs an electrical model")
         self.T0 = float(self.material.reference_temperature)
         self.beta = self.material.beta
-        self.eta = real_number("eta (share of the electrical power released as heat)", eta)
-        if not (0.0 <= self.eta <= 1.0):
-            raise ValueError(f"eta must be in [0, 1], got {eta}")
-        theta_of(theta)
-        self.heat_options = dict(theta=theta, subcycle=subcycle, safety=safety, max_substeps=max_substeps,
-                                 solver=thermal_solver)
+        if not isinstance(integrator, Integrator):
+            raise TypeError(f"integrator must be an Integrator(...) (yade_electro.physics.integrator), got "
+                            f"{integrator!r}")
+        self.integrator = integrator
+        self.eta = float(integrator.eta)
+        self.heat_options = dict(theta=integrator.theta, subcycle=integrator.subcycle, safety=integrator.safety,
+                                 max_substeps=integrator.max_substeps, solver=integrator.solver)
         self.fixed, self.flux, self.convection = list(fixed), list(flux), list(convection)
         for group, cls in ((self.fixed, FixedTemperature), (self.flux, HeatFlux), (self.convection, Convection)):
             for bc in group:
@@ -181,10 +179,9 @@ class ElectroThermalModel:
             # the capacities that go with Voronoi conductances: the cells fill the solid
             cell_volume = self.network.law.cell_volumes
         self.area, self.volume_fraction, self.cell_volume = area, volume_fraction, cell_volume
-        if int(coupling_iterations) != coupling_iterations or coupling_iterations < 0:
-            raise ValueError("coupling_iterations must be an integer >= 0")
-        self.coupling_iterations, self.coupling_tol = int(coupling_iterations), float(coupling_tol)
-        self.resistivity_tol = real_number("resistivity_tol", resistivity_tol)
+        self.coupling_iterations = int(integrator.coupling_iterations)
+        self.coupling_tol = float(integrator.coupling_tol)
+        self.resistivity_tol = real_number("resistivity_tol", integrator.resistivity_tol)
         self.history = History(history) if isinstance(history, str) else history
 
         self.heat: Optional[HeatSolver] = None

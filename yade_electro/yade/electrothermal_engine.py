@@ -28,6 +28,9 @@ from ..physics.integrator import Integrator
 from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
 
+#: the saved ``coupled_options`` that are the model's Integrator settings
+INTEGRATOR_OPTIONS = ("subcycle", "safety", "max_substeps", "coupling_iterations", "coupling_tol", "resistivity_tol")
+
 log = logging.getLogger(__name__)
 
 
@@ -192,10 +195,11 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
             extra.setdefault("law", law)
             extra.setdefault("law_params", self._law_params)
         extra.setdefault("container", self.container)
+        integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
+                                **{k: extra.pop(k) for k in INTEGRATOR_OPTIONS if k in extra})
         self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
-                                           eta=eta, theta=theta, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
-                                           sources=heat_sources, thermal_solver=thermal_solver,
-                                           walls=[w for w, _ in wall_specs], **extra)
+                                           integrator=integrator, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
+                                           sources=heat_sources, walls=[w for w, _ in wall_specs], **extra)
         self._last_time = float(self.O.time)
         self._temperature_writer = TemperatureWriter()
         if initial_temperature is not None and _resume is None:
