@@ -127,30 +127,6 @@ def edge_crack():
                         ("error [%]", "increment_error_pct_paths", "+.2f")], "edge_crack.csv")
 
 
-def two_spheres():
-    d = json.loads((RESULTS / "two_spheres.json").read_text())
-    rows = d.get("rows") or d.get("laws") or []
-    if isinstance(rows, dict):
-        rows = [dict(law=k, **v) for k, v in rows.items()]
-    keys = [k for k in (rows[0] if rows else {}) if "error" in k]
-    cols = [("law", "law", "s")] + [(k.replace("_", " "), k, ".2g") for k in keys]
-    return table(rows, cols, "two_spheres.json")
-
-
-def json_figures(name, keys, source=None):
-    """A two-column table (figure, value) of the scalar ``keys`` of a case's JSON result."""
-    d = json.loads((RESULTS / name).read_text())
-    rows = []
-    for k, spec in keys:
-        v = d
-        for part in k.split("."):
-            v = v.get(part) if isinstance(v, dict) else None
-        rows.append({"figure": k, "value": v, "spec": spec})
-    lines = ["| figure | value |", "|---|---|"]
-    lines += [f"| {r['figure']} | {fmt(r['value'], r['spec'])} |" for r in rows]
-    return "\n".join(lines) + f"\n\n*Generated from `docs/results/{source or name}`.*\n"
-
-
 # ---------------------------------------------------------------------------------------------
 # benchmarks
 # ---------------------------------------------------------------------------------------------

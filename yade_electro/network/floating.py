@@ -22,6 +22,11 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
+from scipy.sparse.csgraph import connected_components
+
+from ..solvers.registry import make_solver
+
 __all__ = ["floating_message", "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",
            "solve_with_floating"]
 
@@ -68,8 +73,6 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
         The connected part of each unknown and the mask of the floating ones; None when no
         part floats.
     """
-    import numpy as np
-    from scipy.sparse.csgraph import connected_components
     if matrix.shape[0] == 0:
         return None
     n_parts, labels = connected_components(matrix, directed=False)
@@ -90,7 +93,6 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
 def hold_at_mean(values, weights, labels, floating):
     """``values`` with each floating part set to its ``weights``-weighted mean (a heat
     content kept: weights are the capacities)."""
-    import numpy as np
     out = np.array(values, dtype=float)
     for lab in np.unique(labels[floating]):
         part = labels == lab
@@ -103,8 +105,6 @@ def solve_with_floating(matrix, rhs, x0, weights, parts, rtol: float):
     each floating part is held at its ``weights``-weighted mean of ``x0``, the others are solved
     apart (they do not touch the floating parts) with a one-off ``'auto'`` solver. Returns
     (x, info); a non-finite result raises ArithmeticError."""
-    import numpy as np
-    from ..solvers.registry import make_solver
     labels, floating = parts
     x = hold_at_mean(x0, weights, labels, floating)
     rest = np.flatnonzero(~floating)

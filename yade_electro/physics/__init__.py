@@ -3,12 +3,12 @@ capacities, Joule sources) and the coupled electro-thermal model (the one owner 
 """
 from .coupled import ElectroThermalModel
 from .electrical import ElectrodeSpec, ElectricalModel, electrode_specs
-from .integrator import Integrator
+from .integrator import Integrator, MODEL_OPTIONS
 from .thermal import (heat_capacity, thermal_conductance, diffusion_time_step, edge_joule_power,
                       joule_sources, electrical_power, heat_solver_on_graph, surface_conditions, source_power)
 from .walls import WallContacts
 
 __all__ = ["ElectroThermalModel", "ElectrodeSpec", "ElectricalModel", "electrode_specs", "Integrator",
-           "heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power",
-           "joule_sources", "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power",
-           "WallContacts"]
+           "MODEL_OPTIONS", "heat_capacity", "thermal_conductance", "diffusion_time_step",
+           "edge_joule_power", "joule_sources", "electrical_power", "heat_solver_on_graph",
+           "surface_conditions", "source_power", "WallContacts"]

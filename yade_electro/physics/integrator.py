@@ -10,7 +10,11 @@ from typing import Any, Optional
 from ..core.materials import real_number
 from ..network.theta import theta_of
 
-__all__ = ["Integrator"]
+__all__ = ["Integrator", "MODEL_OPTIONS"]
+
+#: the Integrator fields the coupled model takes besides theta, eta and the solver (the engines
+#: keep the ones that differ from the default in their saved configuration)
+MODEL_OPTIONS = ("subcycle", "safety", "max_substeps", "coupling_iterations", "coupling_tol", "resistivity_tol")
 
 
 @dataclass(frozen=True)

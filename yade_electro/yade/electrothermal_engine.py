@@ -24,12 +24,9 @@ from .scene import TemperatureWriter, write_body_attribute
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
 from .options import Output, Reader, thermal_settings
-from ..physics.integrator import Integrator
+from ..physics.integrator import MODEL_OPTIONS, Integrator
 from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
-
-#: the saved ``coupled_options`` that are the model's Integrator settings
-INTEGRATOR_OPTIONS = ("subcycle", "safety", "max_substeps", "coupling_iterations", "coupling_tol", "resistivity_tol")
 
 log = logging.getLogger(__name__)
 
@@ -196,7 +193,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
             extra.setdefault("law_params", self._law_params)
         extra.setdefault("container", self.container)
         integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
-                                **{k: extra.pop(k) for k in INTEGRATOR_OPTIONS if k in extra})
+                                **{k: extra.pop(k) for k in MODEL_OPTIONS if k in extra})
         self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
                                            integrator=integrator, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
                                            sources=heat_sources, walls=[w for w, _ in wall_specs], **extra)

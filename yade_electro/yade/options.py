@@ -22,6 +22,7 @@ import numpy as np
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.materials import Material, real_number
 from ..laws.law import Law
+from ..network.kirchhoff import PotentialOrCurrent
 
 __all__ = ["Reader", "Output", "Electrode", "Wall", "Materials", "InitialTemperature", "electrodes_from_dict",
            "walls_from_dict", "electrical_settings", "thermal_settings"]
@@ -136,7 +137,7 @@ class Output:
 
 
 @dataclass(frozen=True)
-class Electrode:
+class Electrode(PotentialOrCurrent):
     """An electrode: where the current enters or leaves, and its potential or current.
 
     Give one place and one value.
@@ -173,9 +174,7 @@ class Electrode:
         if (self.select is not None) + (self.surface is not None) + (self.wall is not None) != 1:
             raise BoundaryConditionError(f"Electrode {self.name!r}: give select= (an element layer), surface= (a "
                                          "surface of the container) or wall= (a wall of a granular bed), one of them")
-        if (self.potential is None) == (self.current is None):
-            raise BoundaryConditionError(f"Electrode {self.name!r}: give exactly one of potential= (V) or current= "
-                                         "(A)")
+        self.check_value()
         if self.wall is not None:
             object.__setattr__(self, "wall", tuple(_body_ids(f"Electrode {self.name!r}: wall", self.wall)))
 
@@ -311,7 +310,7 @@ def _scalar(v):
 
 def _sorted_boundaries(boundaries, engine: str, allowed: tuple) -> dict:
     """The boundary objects grouped by type, with their names checked for clashes."""
-    if isinstance(boundaries, (Electrode, Wall)) or hasattr(boundaries, "name"):
+    if hasattr(boundaries, "name"):           # one boundary object, not a list
         boundaries = [boundaries]
     if isinstance(boundaries, Mapping):
         raise BoundaryConditionError(f"{engine}: boundaries= is a list, e.g. [Electrode('top', surface=rod.face('top'), "
@@ -331,8 +330,7 @@ def _sorted_boundaries(boundaries, engine: str, allowed: tuple) -> dict:
     return groups
 
 
-def _common(law, reader, output, engine: str) -> dict:
-    law = Law.of(law)
+def _common(law: Law, reader, output, engine: str) -> dict:
     if not isinstance(reader, Reader):
         raise TypeError(f"{engine}: reader= must be a Reader(...), got {reader!r}")
     if not isinstance(output, Output):
@@ -354,8 +352,9 @@ def electrical_settings(material, boundaries, law, reader, output) -> dict:
     groups = _sorted_boundaries(boundaries, engine, (Electrode,))
     if not groups[Electrode]:
         raise BoundaryConditionError(f"{engine}: give boundaries=[Electrode(...), Electrode(...)] (at least one)")
+    law = Law.of(law)
     out = _common(law, reader, output, engine)
-    if Law.of(law).volume_fraction is not None:
+    if law.volume_fraction is not None:
         raise ValueError(f"{engine}: Law(volume_fraction=...) sets heat capacities; it is for the heat engines")
     out.update(resistivity=_scalar(mat.resistivity), electrodes={e.name: e.spec() for e in groups[Electrode]},
                materials=table)
@@ -365,7 +364,7 @@ def electrical_settings(material, boundaries, law, reader, output) -> dict:
 def thermal_settings(material, boundaries, temperature, law, integrator, reader, output, engine: str) -> dict:
     """The heat engines' internal settings from their option objects."""
     from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
-    from ..physics.integrator import Integrator
+    from ..physics.integrator import MODEL_OPTIONS, Integrator
     groups = _sorted_boundaries(boundaries, engine, (Electrode, Wall, FixedTemperature, HeatFlux, Convection,
                                                      HeatSource))
     electrodes = groups[Electrode]
@@ -388,14 +387,12 @@ def thermal_settings(material, boundaries, temperature, law, integrator, reader,
     if not isinstance(integrator, Integrator):
         raise TypeError(f"{engine}: integrator= must be an Integrator(...), got {integrator!r}")
     base = Integrator()
-    extra = {k: getattr(integrator, k) for k in ("subcycle", "safety", "max_substeps", "coupling_iterations",
-                                                  "coupling_tol", "resistivity_tol")
-             if getattr(integrator, k) != getattr(base, k)}
+    extra = {k: getattr(integrator, k) for k in MODEL_OPTIONS if getattr(integrator, k) != getattr(base, k)}
     if mat.beta != 0.0:
         extra["reference_temperature"] = float(mat.reference_temperature)
-    law_ = Law.of(law)
-    if law_.volume_fraction is not None:
-        extra["volume_fraction"] = law_.volume_fraction
+    law = Law.of(law)
+    if law.volume_fraction is not None:
+        extra["volume_fraction"] = law.volume_fraction
     out = _common(law, reader, output, engine)
     out.update(resistivity=_scalar(mat.resistivity) if electrodes else None,
                electrodes={e.name: e.spec() for e in electrodes} or None,
