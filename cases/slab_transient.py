@@ -76,7 +76,7 @@ if os.path.dirname(HERE) not in sys.path:  # run from a checkout without install
 from yade_electro.core.errors import ThermalError  # noqa: E402
 from yade_electro.fem.closed_forms import slab_temperature  # noqa: E402
 from yade_electro.core.graph import ContactGraph  # noqa: E402
-from yade_electro.network.conditions import FixedTemperature  # noqa: E402
+from yade_electro.network.heat_conditions import FixedTemperature  # noqa: E402
 from yade_electro.network.transient import HeatSolver  # noqa: E402
 from yade_electro.physics.thermal import diffusion_time_step  # noqa: E402
 from yade_electro.geometry.voronoi import voronoi_cell_volumes  # noqa: E402
@@ -130,7 +130,7 @@ class SlabModel:
 
     def solver(self, theta, subcycle=True, safety=0.9, temperature=T_INITIAL, **kw) -> HeatSolver:
         return HeatSolver(density_times(self) * self.cell_volume, self.graph.edges, self.G, temperature,
-                          fixed=[FixedTemperature("x=L", self.fixed, T_WALL)], theta=theta, subcycle=subcycle,
+                          conditions=[FixedTemperature("x=L", self.fixed, T_WALL)], theta=theta, subcycle=subcycle,
                           safety=safety, **kw)
 
     def exact(self, fo):

@@ -13,7 +13,7 @@ from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.physics.integrator import Integrator
 from yade_electro.core.errors import BoundaryConditionError
 from yade_electro.core.graph import ContactGraph
-from yade_electro.network.conditions import ThermalWall
+from yade_electro.network.heat_conditions import ThermalWall
 
 
 def test_candidate_pairs_are_every_close_pair():
@@ -208,7 +208,7 @@ def _sphere_on_hot_plane(theta, dt, steps, wall_conductivity=None):
     r, k, rho, c = 2e-3, 385.0, 8900.0, 172.0
     g = ContactGraph(np.zeros((1, 3)), [r], np.zeros((0, 2)))
     m = ElectroThermalModel(None, rho, c, k, 0.0, law="contact", volume_fraction=1.0, integrator=Integrator(theta=theta),
-                            walls=[ThermalWall("plate", 100.0, wall_conductivity), ThermalWall("lid")])
+                            boundaries=[ThermalWall("plate", 100.0, wall_conductivity), ThermalWall("lid")])
     dl = 0.1e-3
     m.set_wall_contacts("plate", [0], [dl])
     m.set_wall_contacts("lid", [0], [dl])          # adiabatic: conducts nothing
@@ -238,9 +238,9 @@ def test_wall_inputs_are_checked():
         ThermalWall("w", 300.0, conductivity=-1.0)
     with pytest.raises(BoundaryConditionError, match="names must be non-empty"):
         ThermalWall("", 300.0)
-    with pytest.raises(BoundaryConditionError, match="walls= given with law 'continuum'"):
-        ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="continuum", walls=[ThermalWall("w", 1.0)])
-    m = ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="contact", walls=[ThermalWall("w", 1.0)])
+    with pytest.raises(BoundaryConditionError, match=r"walls \(ThermalWall\) given with law 'continuum'"):
+        ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="continuum", boundaries=[ThermalWall("w", 1.0)])
+    m = ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="contact", boundaries=[ThermalWall("w", 1.0)])
     with pytest.raises(BoundaryConditionError, match="no wall named"):
         m.set_wall_contacts("x", [0], [1e-6])
     with pytest.raises(ValueError, match="overlaps must be finite"):

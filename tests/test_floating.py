@@ -14,7 +14,7 @@ EDGES = [[0, 1], [1, 2], [3, 4]]
 
 def heat(**kw):
     return HeatSolver(np.array([1.0, 1.0, 1.0, 2.0, 1.0]), EDGES, [1.0, 1.0, 1.0], [0.0, 0.0, 0.0, 300.0, 330.0],
-                      fixed=[FixedTemperature("cold", [0], 300.0), FixedTemperature("hot", [2], 400.0)], **kw)
+                      conditions=[FixedTemperature("cold", [0], 300.0), FixedTemperature("hot", [2], 400.0)], **kw)
 
 
 def test_a_floating_part_keeps_its_mean_temperature_in_a_steady_solve():
@@ -53,3 +53,4 @@ def test_current_follows_the_same_policy():
         solve_potential(5, EDGES, [1.0, 1.0, 1.0], [Electrode("a", [0], potential=1.0),
                                                      Electrode("b", [2], potential=0.0),
                                                      Electrode("c", [3], current=1.0)])
+

@@ -26,7 +26,7 @@ from yade_electro.core.history import History
 from yade_electro.core.errors import BoundaryConditionError
 from yade_electro.network.kirchhoff import Electrode
 from yade_electro.laws.transmission import edge_transmission_surface, volume_fraction
-from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux
+from yade_electro.network.heat_conditions import Convection, FixedTemperature, HeatFlux
 from yade_electro.network.transient import HeatSolver
 from yade_electro.laws.transmission import exposed_area
 from yade_electro.network.theta import theta_of
@@ -177,9 +177,7 @@ def test_energy_balance_with_every_boundary_condition():
     n = C.size
     for theta in (0.0, 0.5, 1.0):
         hs = HeatSolver(C, edges, G, 300.0, theta=theta,
-                        fixed=[FixedTemperature("cold", [0], 280.0)],
-                        flux=[HeatFlux("heater", [5, 6], power=3.0), HeatFlux("sun", [9], flux=100.0, area=0.01)],
-                        convection=[Convection("air", np.arange(7, 12), h=20.0, t_inf=310.0, area=0.05)])
+                        conditions=[FixedTemperature("cold", [0], 280.0), HeatFlux("heater", [5, 6], power=3.0), HeatFlux("sun", [9], flux=100.0, area=0.01), Convection("air", np.arange(7, 12), h=20.0, t_inf=310.0, area=0.05)])
         src = np.linspace(0.0, 1.0, n)
         T_start = hs.temperature
         for _ in range(7):
@@ -234,7 +232,7 @@ def test_chain_steady_state_is_linear(solver):
     n = 21
     C, edges, G = chain(n)
     hs = HeatSolver(C, edges, G, 300.0, theta=1.0, solver=solver,
-                    fixed=[FixedTemperature("hot", [0], 400.0), FixedTemperature("cold", [n - 1], 300.0)])
+                    conditions=[FixedTemperature("hot", [0], 400.0), FixedTemperature("cold", [n - 1], 300.0)])
     for _ in range(3):
         hs.advance(1e16)
     np.testing.assert_allclose(hs.temperature, np.linspace(400.0, 300.0, n), rtol=0, atol=1e-10)
@@ -247,7 +245,7 @@ def test_lattice_bar_steady_state_is_linear():
     g = rod()
     z = g.pos[:, 2]
     hs = HeatSolver(np.ones(g.n_nodes), g.edges, np.full(g.n_edges, 0.3), 300.0, theta=1.0, graph=g,
-                    fixed=[FixedTemperature("hot", top, 500.0), FixedTemperature("cold", bottom, 300.0)])
+                    conditions=[FixedTemperature("hot", top, 500.0), FixedTemperature("cold", bottom, 300.0)])
     for _ in range(3):
         hs.advance(1e16)
     np.testing.assert_allclose(hs.temperature, 300.0 + 200.0 * z / Z_TOP, rtol=0, atol=1e-10)
@@ -257,7 +255,7 @@ def test_backward_euler_stable_at_100x_explicit_limit():
     n = 15
     C, edges, G = chain(n)
     hs = HeatSolver(C, edges, G, 300.0, theta="backward-euler",
-                    fixed=[FixedTemperature("hot", [0], 400.0), FixedTemperature("warm", [n - 1], 350.0)])
+                    conditions=[FixedTemperature("hot", [0], 400.0), FixedTemperature("warm", [n - 1], 350.0)])
     dt = 100 * hs.critical_time_step
     prev = hs.temperature
     for _ in range(60):
@@ -337,7 +335,7 @@ def test_adiabatic_joule_heating_of_a_bar(theta, tmp_path):
 def test_convection_of_one_element(theta, factor):
     C, h, A, T_inf = 4.0, 25.0, 0.01, 300.0
     hs = HeatSolver([C], np.zeros((0, 2)), np.zeros(0), 400.0, theta=theta,
-                    convection=[Convection("air", [0], h=h, t_inf=T_inf, area=A)])
+                    conditions=[Convection("air", [0], h=h, t_inf=T_inf, area=A)])
     assert hs.critical_time_step == pytest.approx(C / (h * A))
     dt = 0.2 * C / (h * A)
     a = h * A * dt / C
@@ -350,7 +348,7 @@ def test_convection_of_one_element(theta, factor):
 def test_convection_rate_is_hA_over_C():
     C, h, A, T_inf = 4.0, 25.0, 0.01, 300.0
     hs = HeatSolver([C], np.zeros((0, 2)), np.zeros(0), 400.0, theta="crank-nicolson",
-                    convection=[Convection("air", [0], h=h, t_inf=T_inf, area=A)])
+                    conditions=[Convection("air", [0], h=h, t_inf=T_inf, area=A)])
     t_end = 2 * C / (h * A)
     for _ in range(1000):
         hs.advance(t_end / 1000)
@@ -361,11 +359,11 @@ def test_convection_rate_is_hA_over_C():
 def test_default_exposed_area_with_graph():
     g = rod()
     hs = heat_solver_on_graph(g, DENSITY, SPECIFIC_HEAT, LAMBDA, 400.0,
-                               convection=[Convection("air", np.ones(g.n_nodes, bool), h=10.0, t_inf=300.0)])
+                               conditions=[Convection("air", np.ones(g.n_nodes, bool), h=10.0, t_inf=300.0)])
     np.testing.assert_allclose(hs.h_area, 10.0 * exposed_area(g))
     with pytest.raises(BoundaryConditionError, match="area"):
         HeatSolver(np.ones(3), [[0, 1], [1, 2]], [1.0, 1.0], 300.0,
-                   convection=[Convection("air", [0], h=10.0, t_inf=300.0)])
+                   conditions=[Convection("air", [0], h=10.0, t_inf=300.0)])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -482,9 +480,9 @@ def test_bad_time_step_raises_value_error(dt):
 def test_bad_boundary_conditions():
     C, edges, G = chain(4)
     with pytest.raises(BoundaryConditionError, match="both"):
-        HeatSolver(C, edges, G, 300.0, fixed=[FixedTemperature("a", [0, 1], 1.0), FixedTemperature("b", [1], 2.0)])
+        HeatSolver(C, edges, G, 300.0, conditions=[FixedTemperature("a", [0, 1], 1.0), FixedTemperature("b", [1], 2.0)])
     with pytest.raises(BoundaryConditionError, match="no element"):
-        HeatSolver(C, edges, G, 300.0, fixed=[FixedTemperature("a", [], 1.0)])
+        HeatSolver(C, edges, G, 300.0, conditions=[FixedTemperature("a", [], 1.0)])
     with pytest.raises(BoundaryConditionError, match="exactly one"):
         HeatFlux("q", [0], power=1.0, flux=2.0)
     with pytest.raises(BoundaryConditionError):

@@ -16,7 +16,7 @@ from yade_electro.core.errors import BoundaryConditionError, ThermalError
 from yade_electro.geometry.shapes import Box, Cylinder, Difference
 from yade_electro.geometry.surfaces import Plane
 from yade_electro.packing import bond_pairs, dense_packing
-from yade_electro.network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
+from yade_electro.network.heat_conditions import Convection, FixedTemperature, HeatFlux, HeatSource
 from yade_electro.geometry.cells import bounded_cells
 
 R, L = 1e-3, 5e-3
@@ -56,7 +56,7 @@ def _heat_only(graph, **kw):
 
 
 def test_steady_state_with_one_end_held_and_the_rest_insulated_is_uniform(rod):
-    m = _heat_only(rod, fixed=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=350.0)])
+    m = _heat_only(rod, boundaries=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=350.0)])
     m.steady_state(rod)
     np.testing.assert_allclose(m.temperature, 350.0, rtol=0, atol=1e-8)
     assert abs(m.heat.steady(apply=False).boundary_power) < 1e-9          # W: nothing flows
@@ -65,9 +65,8 @@ def test_steady_state_with_one_end_held_and_the_rest_insulated_is_uniform(rod):
 def test_steady_parabola_with_both_ends_held_and_a_uniform_source(rod):
     """T(z) = T0 + q z (L - z) / (2 lambda) with the end faces (not the end layers) at T0."""
     q = 2e9                                        # W/m^3: a 208 K rise at mid-length
-    m = _heat_only(rod, fixed=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=300.0),
-                               FixedTemperature("top", surface=ROD.face("top"), temperature=300.0)],
-                   sources=[HeatSource("joule", density=q)])
+    m = _heat_only(rod, boundaries=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=300.0),
+                               FixedTemperature("top", surface=ROD.face("top"), temperature=300.0), HeatSource("joule", density=q)])
     row = m.steady_state(rod)
     z = rod.pos[:, 2]
     exact = q * z * (L - z) / (2 * LAM)
@@ -86,9 +85,7 @@ def test_steady_parabola_with_both_ends_held_and_a_uniform_source(rod):
 
 def test_surface_flux_and_convection_act_on_the_boundary_faces(rod):
     side = ROD.face("side")
-    m = _heat_only(rod, fixed=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=300.0)],
-                   flux=[HeatFlux("laser", surface=ROD.face("top"), flux=1e6)],
-                   convection=[Convection("air", surface=side, h=1e-6, t_inf=300.0)])
+    m = _heat_only(rod, boundaries=[FixedTemperature("bottom", surface=ROD.face("bottom"), temperature=300.0), HeatFlux("laser", surface=ROD.face("top"), flux=1e6), Convection("air", surface=side, h=1e-6, t_inf=300.0)])
     m.prepare(rod)
     heat = m.heat
     top = heat.nodes_of["laser"]
@@ -108,7 +105,7 @@ def test_surface_flux_and_convection_act_on_the_boundary_faces(rod):
 
 def test_surface_conditions_that_miss_the_boundary_are_refused(rod):
     inside = Plane((0, 0, L / 2), (0, 0, 1), tol=1e-6)   # a plane across the rod: no boundary face on it
-    m = _heat_only(rod, convection=[Convection("air", surface=inside, h=10.0, t_inf=300.0)])
+    m = _heat_only(rod, boundaries=[Convection("air", surface=inside, h=10.0, t_inf=300.0)])
     with pytest.raises(BoundaryConditionError, match="holds none of the packing's boundary faces"):
         m.prepare(rod)
     with pytest.raises(BoundaryConditionError, match="not both"):
@@ -124,7 +121,7 @@ def test_surface_conditions_that_miss_the_boundary_are_refused(rod):
 
 
 def test_a_steady_state_with_nowhere_for_the_heat_to_go_is_refused(rod):
-    m = _heat_only(rod, flux=[HeatFlux("laser", surface=ROD.face("top"), flux=1e6)])
+    m = _heat_only(rod, boundaries=[HeatFlux("laser", surface=ROD.face("top"), flux=1e6)])
     with pytest.raises(ThermalError, match="reach no fixed temperature and no convection"):
         m.steady_state(rod)
 

@@ -274,7 +274,7 @@ EXPECTED = {
     "density NaN": ("MaterialError", "density"), "density string": ("MaterialError", "density"),
     "conductivity string": ("MaterialError", "conductivity"), "specific_heat 0": ("MaterialError", "specific_heat"),
     "theta": ("ValueError", "unknown integrator"), "theta number": ("ValueError", "theta must be in [0, 1]"),
-    "fixed selects nothing": ("BoundaryConditionError", "thermal boundary condition 'hot' selects no element"),
+    "fixed selects nothing": ("BoundaryConditionError", "fixed-temperature boundary condition 'hot' selects no element"),
     "fixed overlap": ("BoundaryConditionError", "fixed-temperature boundary conditions 'a' and 'b'"),
     "convection bad area": ("BoundaryConditionError", "convection boundary condition 'air': areas must be finite"),
     "flux not a BC": ("TypeError", "HeatFlux"),

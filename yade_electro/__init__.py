@@ -31,8 +31,9 @@ from .laws import (conductance_laws, eccentricity, edge_transmission_surface, ge
                    polyhedron_alpha, polyhedron_volume_fraction, register_conductance_law, transmission_surface,
                    volume_fraction)
 from .solvers import AMGSolver, CGSolver, DeflatedCGSolver, DirectSolver, make_solver, solver_names
-from .network import (ConductionProblem, Convection, Electrode, FixedTemperature, HeatFlux, HeatSolver, HeatSource,
-                      PotentialSolution, SteadyHeat, ThermalWall, equivalent_resistance, laplacian, solve_potential)
+from .network import (ConductionProblem, Convection, Electrode, FixedTemperature, FixedValue, HeatFlux, HeatSolver,
+                      HeatSource, Injection, PotentialSolution, Robin, Source, SteadyHeat, Terminal, ThermalWall,
+                      equivalent_resistance, laplacian, solve_potential)
 from .physics import (ElectricalModel, ElectrodeSpec, ElectroThermalModel, heat_capacity, heat_solver_on_graph,
                       joule_sources, thermal_conductance)
 from .post import (element_gradients, line_probe, plane_probe, probe, region_mean, section_mean, slab_means)
@@ -53,6 +54,7 @@ __all__ = [
     # solvers
     "make_solver", "solver_names", "DirectSolver", "CGSolver", "DeflatedCGSolver", "AMGSolver",
     # the transport core
+    "FixedValue", "Terminal", "Injection", "Robin", "Source",
     "Electrode", "PotentialSolution", "ConductionProblem", "laplacian", "solve_potential", "equivalent_resistance",
     "HeatSolver", "FixedTemperature", "HeatFlux", "Convection", "HeatSource", "ThermalWall", "SteadyHeat",
     # physics

@@ -91,6 +91,8 @@ class ConductionProblem:
     edges : (m, 2) int array
     conductance : (m,) array [S], >= 0
     electrodes : sequence of Electrode
+        Or the generic :class:`~yade_electro.network.boundary.Terminal` (``value=`` a fixed
+        potential, ``rate=`` an imposed current).
     injection : (n,) currents injected into nodes [A], optional
     solver : name or solver object (see :mod:`yade_electro.solvers.registry`); 'auto' by size
     coords : (n, 3) node positions [m], optional (for the coarse space of 'cg-deflated')
@@ -104,6 +106,10 @@ class ConductionProblem:
             raise ValueError(f"edge node index out of range 0..{n - 1}")
         self.c = self._check_conductance(conductance)
         self.electrodes = list(electrodes)
+        for e in self.electrodes:
+            if getattr(e, "ROLE", None) != "terminal" or getattr(e, "nodes", None) is None:
+                raise BoundaryConditionError(f"electrodes must be Electrode(name, nodes, potential=|current=) or "
+                                             f"Terminal(name, nodes, value=|rate=) objects, got {e!r}")
         if not self.electrodes:
             raise BoundaryConditionError("no electrode given: at least one fixed-potential electrode is needed")
         names = [e.name for e in self.electrodes]
@@ -138,7 +144,7 @@ class ConductionProblem:
         self.basis_solves = 0
         self._phi = None                 # (nu, ne) characteristic potentials, warm start
         self._build()
-        self._check_return_paths([e.value for e in self.electrodes])
+        self._check_return_paths([e.amount for e in self.electrodes])
 
     # -- structure ------------------------------------------------------------------------
     def _check_conductance(self, conductance):
@@ -369,7 +375,7 @@ class ConductionProblem:
         """Potentials and currents for electrode ``values`` (name -> V or A; default the
         electrodes' own values). Costs a linear solve only when the conductances changed."""
         t0 = time.perf_counter()
-        vals = [e.value for e in self.electrodes]
+        vals = [e.amount for e in self.electrodes]
         if values:
             idx = {nm: k for k, nm in enumerate(self.names)}
             for name, v in values.items():

@@ -5,7 +5,7 @@ See :mod:`yade_electro.network.conduction` for the sign conventions. Units: SI (
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import ClassVar, Dict, Optional
 
 import numpy as np
 import scipy.sparse as sp
@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.materials import real_number
+from .boundary import Condition, check_condition
 
 __all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "PotentialOrCurrent",
            "Electrode"]
@@ -65,17 +66,19 @@ def edge_power(branch_current, conductance) -> np.ndarray:
     return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
 
 
-class PotentialOrCurrent:
+class PotentialOrCurrent(Condition):
     """What an electrode imposes, the same for every kind of electrode: a fixed ``potential``
-    [V] or an imposed ``current`` [A] fed into the network, exactly one, a finite real number
-    (checked by :meth:`check_value` in the subclass's ``__post_init__``)."""
+    [V] or an imposed ``current`` [A] fed into the network, exactly one, a finite real number.
+    The electrical name of a :class:`~yade_electro.network.boundary.Terminal`: checked by the
+    terminal's one check (:meth:`check_value`, from the subclass's ``__post_init__``)."""
+
+    ROLE: ClassVar[str] = "terminal"
+    KIND: ClassVar[str] = "electrode"
+    FIELDS: ClassVar[Dict[str, str]] = {"value": "potential", "rate": "current"}
+    UNITS: ClassVar[Dict[str, str]] = {"value": "V", "rate": "A"}
 
     def check_value(self):
-        if (self.potential is None) == (self.current is None):
-            raise BoundaryConditionError(f"electrode {self.name!r}: give exactly one of potential= "
-                                         "(fixed potential, V) or current= (imposed current, A)")
-        v = electrode_value(self.name, self.potential if self.potential is not None else self.current)
-        object.__setattr__(self, "potential" if self.potential is not None else "current", v)
+        check_condition(self)
 
     @property
     def fixed(self) -> bool:
@@ -87,10 +90,16 @@ class PotentialOrCurrent:
         """The potential [V] or the current [A]."""
         return float(self.potential if self.fixed else self.current)
 
+    @property
+    def amount(self) -> float:
+        """The potential [V] or the current [A] (the terminal's name for :attr:`value`)."""
+        return self.value
+
 
 @dataclass(frozen=True)
 class Electrode(PotentialOrCurrent):
-    """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current.
+    """A set of nodes tied by a perfect conductor, at a fixed potential or fed a current: the
+    electrical name of :class:`~yade_electro.network.boundary.Terminal`.
 
     Parameters
     ----------
@@ -108,16 +117,3 @@ class Electrode(PotentialOrCurrent):
     nodes: np.ndarray
     potential: Optional[float] = None
     current: Optional[float] = None
-
-    def __post_init__(self):
-        raw = np.asarray(self.nodes).reshape(-1)
-        if raw.size and not (np.issubdtype(raw.dtype, np.integer)):
-            raise BoundaryConditionError(f"electrode {self.name!r}: nodes must be integer indices, got "
-                                         f"{raw[:5].tolist()}")
-        nodes = np.unique(raw.astype(np.int64))
-        if nodes.size == 0:
-            raise BoundaryConditionError(f"electrode {self.name!r} selects no element: check its "
-                                         "predicate/box, ids or mask against the packing")
-        self.check_value()
-        nodes.setflags(write=False)
-        object.__setattr__(self, "nodes", nodes)

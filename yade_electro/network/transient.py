@@ -40,7 +40,8 @@ from ..solvers.cg import CGSolver
 from ..solvers.base import DirectSolver
 from ..solvers.registry import make_solver
 from .condensation import ReducedSystem
-from .conditions import Convection, FixedTemperature, HeatFlux, boundary_value, resolve_conditions
+from .boundary import boundary_value
+from .resolution import resolve_conditions
 from .floating import floating_parts, solve_with_floating
 from .records import HeatStep, SteadyHeat, ThermalState, read_only_copy as _ro
 from .theta import theta_of
@@ -70,7 +71,10 @@ class HeatSolver:
     edges : (m, 2) node indices
     conductance : (m,) thermal conductances G_ij [W/K], >= 0
     temperature : float or (n,) initial temperatures; fixed-temperature nodes take their value
-    fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
+    conditions : sequence of boundary conditions
+        Fixed values, injections and Robin terms (:mod:`~yade_electro.network.boundary`), by
+        their thermal names ``FixedTemperature``, ``HeatFlux``, ``Convection`` or the generic
+        ``FixedValue``, ``Injection``, ``Robin``.
     theta : float in [0, 1] or 'explicit' (0), 'crank-nicolson' (1/2), 'backward-euler' (1, default)
     subcycle : bool
         For theta < 1/2, split a step above the stable one into sub-steps (default) or raise.
@@ -114,8 +118,7 @@ class HeatSolver:
 
     RTOL = 1e-12
 
-    def __init__(self, capacity, edges, conductance, temperature, *, fixed: Sequence[FixedTemperature] = (),
-                 flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), theta="backward-euler",
+    def __init__(self, capacity, edges, conductance, temperature, *, conditions: Sequence = (), theta="backward-euler",
                  subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="cg",
                  time: float = 0.0, energy: Optional[dict] = None, graph: Optional[ContactGraph] = None, area=None,
                  nodes_of: Optional[dict] = None, area_of: Optional[dict] = None, link_of: Optional[dict] = None,
@@ -141,12 +144,13 @@ class HeatSolver:
                 raise ValueError(f"area must be an ({n},) array, got {default_area.shape}")
 
         # boundary conditions -> node sets and per-node arrays
-        self.fixed_bcs, self.flux_bcs, self.convection_bcs = list(fixed), list(flux), list(convection)
-        r = resolve_conditions(n, self.fixed_bcs, self.flux_bcs, self.convection_bcs, graph=graph,
+        self.conditions = list(conditions)
+        self.fixed_bcs = [b for b in self.conditions if getattr(b, "ROLE", None) == "fixed"]
+        r = resolve_conditions(n, self.conditions, graph=graph,
                                default_area=default_area, nodes_of=nodes_of, area_of=area_of, link_of=link_of,
                                power=power)
         self._fixed_nodes, self._links, self.fixed = r.fixed_nodes, r.links, r.fixed
-        self._fixed_value = {b.name: float(b.temperature) for b in self.fixed_bcs}
+        self._fixed_value = {b.name: float(b.field("value")) for b in self.fixed_bcs}
         self._conv_hA, self._conv_hAT = r.h_area, r.h_area_t_inf
         self.flux_power = _ro(r.power)
         self._refresh_links()

@@ -44,7 +44,8 @@ from ..core.history import History
 from ..core.materials import Material, real_number, thermal_conductance_of
 from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
-from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource, ThermalWall
+from ..network.boundary import Condition, FixedValue
+from ..network.heat_conditions import ThermalWall
 from ..network.transient import HeatSolver
 from .thermal import diffusion_time_step, heat_capacity, source_power, surface_conditions
 
@@ -80,14 +81,18 @@ class ElectroThermalModel:
         of the electrical power released as heat, paper 000 eq. 11) and the coupling to rho_e(T)
         (:class:`~yade_electro.physics.integrator.Integrator`; its ``dt``, ``time_scale`` and
         ``steady`` are the engines' per-call settings).
-    fixed, flux, convection : sequences of FixedTemperature, HeatFlux, Convection
-        Their ``nodes`` are selectors as for electrodes (callable, mask, graph ids), resolved
-        on the first graph and then kept by element id; or ``surface=`` a surface of the
-        ``container`` (see :mod:`yade_electro.geometry.boundary`): a fixed temperature then acts through
-        the touching elements' half cells, a flux on their boundary faces' areas, convection
-        on those areas in series with the half cells.
-    sources : sequence of HeatSource, optional
-        Heat sources inside the solid [W or W/m^3], shared by element volume.
+    boundaries : sequence of boundary conditions
+        ``FixedTemperature``, ``HeatFlux``, ``Convection``, ``HeatSource`` and ``ThermalWall``
+        (or the generic ``FixedValue``, ``Injection``, ``Robin``, ``Source`` of
+        :mod:`yade_electro.network.boundary`), in one list. Their ``nodes`` are selectors as
+        for electrodes (callable, mask, graph ids), resolved on the first graph and then kept
+        by element id; or ``surface=`` a surface of the ``container`` (see
+        :mod:`yade_electro.geometry.boundary`): a fixed temperature then acts through the
+        touching elements' half cells, a flux on their boundary faces' areas, convection on
+        those areas in series with the half cells. Heat sources act inside the solid [W or
+        W/m^3], shared by element volume. Walls of a granular bed are isothermal or adiabatic;
+        their contacts are given before each step by :meth:`set_wall_contacts` (the YADE
+        engine does it from the scene); they need a contact law ('contact', 'liggghts').
     container : Shape, optional
         The solid, for surface conditions (default: the electrical model's, or the law's).
     area : callable(graph) -> (n,) exposed areas [m^2], optional
@@ -98,19 +103,13 @@ class ElectroThermalModel:
     law, law_params : conductance law of the heat-only model (``electrical=None``).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
-    walls : sequence of ThermalWall, optional
-        Walls of a granular bed (isothermal or adiabatic); their contacts are given before
-        each step by :meth:`set_wall_contacts` (the YADE engine does it from the scene).
-        Needs a contact law ('contact', 'liggghts').
     """
 
     def __init__(self, electrical: Optional[ElectricalModel], density, specific_heat, conductivity,
                  temperature: float, *, reference_temperature: Optional[float] = None, beta: float = 0.0,
-                 integrator: Integrator = Integrator(), fixed: Sequence[FixedTemperature] = (),
-                 flux: Sequence[HeatFlux] = (), convection: Sequence[Convection] = (), area=None,
+                 integrator: Integrator = Integrator(), boundaries: Sequence = (), area=None,
                  volume_fraction=None, cell_volume=None, law="continuum", law_params: Optional[dict] = None,
-                 history=None, sources: Sequence[HeatSource] = (), container=None,
-                 walls: Sequence[ThermalWall] = ()):
+                 history=None, container=None):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.physics.electrical) or None")
         self.electrical = electrical
@@ -130,32 +129,27 @@ class ElectroThermalModel:
         self.eta = float(integrator.eta)
         self.heat_options = dict(theta=integrator.theta, subcycle=integrator.subcycle, safety=integrator.safety,
                                  max_substeps=integrator.max_substeps, solver=integrator.solver)
-        self.fixed, self.flux, self.convection = list(fixed), list(flux), list(convection)
-        for group, cls in ((self.fixed, FixedTemperature), (self.flux, HeatFlux), (self.convection, Convection)):
-            for bc in group:
-                if not isinstance(bc, cls):
-                    raise TypeError(f"expected {cls.__name__} objects, got {bc!r}")
-        names = [b.name for b in self.fixed + self.flux + self.convection]
+        self.conditions, self.heat_sources, self.walls = [], [], []
+        for bc in boundaries:
+            if isinstance(bc, ThermalWall):
+                self.walls.append(bc)
+            elif isinstance(bc, Condition) and bc.ROLE in ("fixed", "injection", "robin"):
+                self.conditions.append(bc)
+            elif isinstance(bc, Condition) and bc.ROLE == "source":
+                self.heat_sources.append(bc)
+            else:
+                raise TypeError(f"boundaries= takes FixedTemperature, HeatFlux, Convection, HeatSource and "
+                                f"ThermalWall objects (or FixedValue, Injection, Robin, Source), got {bc!r}")
+        names = [b.name for b in self.conditions + self.heat_sources + self.walls]
         if len(set(names)) != len(names):
-            raise BoundaryConditionError(f"thermal boundary condition names must be unique, got {names}")
-        self.heat_sources = list(sources)
-        for src in self.heat_sources:
-            if not isinstance(src, HeatSource):
-                raise TypeError(f"expected HeatSource objects, got {src!r}")
-        names += [src.name for src in self.heat_sources]
-        self.walls = list(walls)
-        for w in self.walls:
-            if not isinstance(w, ThermalWall):
-                raise TypeError(f"expected ThermalWall objects (yade_electro.network.transient) in walls=, got {w!r}")
-        names += [w.name for w in self.walls]
-        if len(set(names)) != len(names):
-            raise BoundaryConditionError(f"thermal boundary condition and heat source names must be unique, got {names}")
-        everything = self.fixed + self.flux + self.convection
-        self.bc_memberships = {b.name: Membership(b.name, b.nodes, what="thermal boundary condition")
+            raise BoundaryConditionError(f"thermal boundary condition, heat source and wall names must be unique, "
+                                         f"got {names}")
+        everything = self.conditions
+        self.bc_memberships = {b.name: Membership(b.name, b.nodes, what=b.KIND)
                                for b in everything if b.surface is None}
-        self.bc_memberships.update({src.name: Membership(src.name, src.nodes, what="heat source")
+        self.bc_memberships.update({src.name: Membership(src.name, src.nodes, what=src.KIND)
                                     for src in self.heat_sources if src.nodes is not None})
-        self.bc_surfaces = {b.name: SurfaceMembership(b.name, b.surface, what="thermal boundary condition")
+        self.bc_surfaces = {b.name: SurfaceMembership(b.name, b.surface, what=b.KIND)
                             for b in everything if b.surface is not None}
         self.network = electrical.network if electrical is not None else FactorNetwork(
             make_law(law, **dict(law_params or {})))
@@ -164,7 +158,7 @@ class ElectroThermalModel:
             try:
                 law_.wall_factor(np.ones(1), np.zeros(1))
             except ValueError as exc:
-                raise BoundaryConditionError(f"walls= given with law {law_.name!r}: {exc}") from None
+                raise BoundaryConditionError(f"walls (ThermalWall) given with law {law_.name!r}: {exc}") from None
         self._wall_contacts = WallContacts([w.name for w in self.walls], what="wall")
         self._walls_applied = None
         if container is None and electrical is not None:
@@ -329,20 +323,20 @@ class ElectroThermalModel:
             T = self._T_restore(graph)
         nodes_of = {name: m.nodes(graph) for name, m in self.bc_memberships.items()}
         surface_nodes, area_of, link_of = surface_conditions(
-            self.fixed + self.flux + self.convection,
+            self.conditions,
             {name: m.contact(graph, self._boundary) for name, m in self.bc_surfaces.items()},
             self.material.conductivity)
         nodes_of.update(surface_nodes)
-        fixed = list(self.fixed)
+        conditions = list(self.conditions)
         for w in self.walls:
             if w.isothermal:
-                fixed.append(FixedTemperature(w.name, nodes=np.zeros(0, dtype=np.int64), temperature=w.temperature))
+                conditions.append(FixedValue(w.name, nodes=np.zeros(0, dtype=np.int64), value=w.temperature))
                 nodes_of[w.name], link_of[w.name] = np.zeros(0, dtype=np.int64), np.zeros(0)
         capacity = self._capacities(graph)
         area = self.area(graph) if callable(self.area) else self.area
         self._walls_applied = None
         self.heat = HeatSolver(capacity, self.network.edges, self._thermal_conductance(graph), T,
-                               fixed=fixed, flux=self.flux, convection=self.convection, time=time,
+                               conditions=conditions, time=time,
                                energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
                                link_of=link_of, power=self._source_power(graph), coords=graph.pos,
                                **self.heat_options)

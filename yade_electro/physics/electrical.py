@@ -38,7 +38,7 @@ from ..solvers.registry import check_solver_name
 
 from .walls import WallContacts
 
-from ..network.conditions import check_place
+from ..network.boundary import check_place
 
 __all__ = ["ElectrodeSpec", "ElectricalModel", "electrode_specs"]
 

@@ -31,7 +31,6 @@ from ..core.materials import positive_property, thermal_conductance_of
 from ..laws.factors import make_law
 from ..laws.transmission import volume_fraction as _volume_fraction
 from ..network.kirchhoff import edge_power
-from ..network.conditions import Convection, FixedTemperature
 from ..network.transient import HeatSolver
 
 __all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
@@ -164,8 +163,9 @@ def surface_conditions(conditions, contacts: dict, conductivity):
 
     Parameters
     ----------
-    conditions : sequence of FixedTemperature, HeatFlux and Convection; those with no
-        ``surface`` are skipped
+    conditions : sequence of fixed values, injections and Robin conditions
+        (``FixedTemperature``, ``HeatFlux``, ``Convection``); those with no ``surface`` are
+        skipped
     contacts : dict name -> :class:`~yade_electro.geometry.boundary.SurfaceContact`
         of each surface condition on the current graph
     conductivity : float or (n,) [W/(m K)]
@@ -183,10 +183,10 @@ def surface_conditions(conditions, contacts: dict, conductivity):
             continue
         contact = contacts[b.name]
         nodes_of[b.name] = contact.nodes
-        if isinstance(b, FixedTemperature):
+        if b.ROLE == "fixed":
             link_of[b.name] = (lam if lam.ndim == 0 else lam[contact.nodes]) * contact.factor
-        elif isinstance(b, Convection):
-            area_of[b.name] = contact.convection_area(b.h, lam)
+        elif b.ROLE == "robin":
+            area_of[b.name] = contact.convection_area(b.field("coefficient"), lam)
         else:
             area_of[b.name] = contact.area
     return nodes_of, area_of, link_of
@@ -201,8 +201,8 @@ def source_power(sources, nodes_of: dict, volume) -> np.ndarray:
     for src in sources:
         nodes = nodes_of[src.name]
         v = volume[nodes]
-        if src.power is not None:
-            np.add.at(q, nodes, src.power * v / v.sum())
+        if src.field("rate") is not None:
+            np.add.at(q, nodes, src.field("rate") * v / v.sum())
         else:
-            np.add.at(q, nodes, src.density * v)
+            np.add.at(q, nodes, src.field("density") * v)
     return q

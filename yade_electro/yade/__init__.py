@@ -11,7 +11,7 @@ Importing this subpackage does not import YADE by itself; the functions that nee
 
 from ..core.materials import Material
 from ..laws.law import Law
-from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
+from ..network.heat_conditions import Convection, FixedTemperature, HeatFlux, HeatSource
 from ..physics.integrator import Integrator
 from .electrical_engine import ElectricalEngine
 from .electrothermal_engine import ElectroThermalEngine

@@ -43,7 +43,7 @@ from .granular import check_wall_bodies
 from .scene import write_body_attribute
 
 from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
-from .options import Output, Reader, electrical_settings
+from .options import Electrode, Output, Reader, electrical_settings
 __all__ = ["ElectricalEngine"]
 
 log = logging.getLogger(__name__)
@@ -150,42 +150,32 @@ class ElectricalEngine(EngineBase):
     def _make_electrical(self, resistivity, electrodes, law, law_params, solver, measure, reselect):
         if resistivity is None:
             raise ValueError("give resistivity= (ohm m)")
-        if electrodes is None or not isinstance(electrodes, dict) or not electrodes:
-            raise BoundaryConditionError("give electrodes={name: dict(select=... or surface=..., potential=V | "
-                                         "current=A)}")
+        if not electrodes or not all(isinstance(e, Electrode) for e in electrodes):
+            raise BoundaryConditionError("give boundaries=[Electrode(...), Electrode(...)] (at least one)")
         self._law_params = law_params
         specs = []
-        for name, spec in electrodes.items():
-            if not isinstance(spec, dict):
-                raise BoundaryConditionError(f"electrode {name!r}: give a dict(select=... or surface=..., "
-                                             "potential=...|current=...)")
-            spec = dict(spec)
-            if spec.get("select") is not None:
-                spec["select"] = self._normalise_selector(spec["select"])
-            unknown = set(spec) - {"select", "surface", "potential", "current", "wall"}
-            if unknown:
-                raise BoundaryConditionError(f"electrode {name!r}: unknown key(s) {sorted(unknown)}; give select=, "
-                                             "surface= or wall=, and potential= (V) or current= (A)")
-            if spec.get("wall") is not None:           # granular mode only: checked in _start
-                check_wall_bodies(self.O, name, spec["wall"])
-                spec["wall"] = True
-            specs.append(ElectrodeSpec(name, **spec))
+        for e in electrodes:
+            if e.wall is not None:           # granular mode only: checked in _start
+                check_wall_bodies(self.O, e.name, list(e.wall))
+            specs.append(ElectrodeSpec(e.name, select=None if e.select is None else self._normalise_selector(e.select),
+                                       surface=e.surface, wall=e.wall is not None, potential=e.potential,
+                                       current=e.current))
         self._resistivity = resistivity
         return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
                                reselect=reselect, container=self.container)
 
     # -- persistence ---------------------------------------------------------------------------
-    def _electrode_config(self):
-        out = {}
+    def _electrode_config(self) -> list:
+        """The electrodes as saved with the scene: Electrode objects, element layers by body id."""
+        out = []
         for s in self.model.specs:
-            value = {"potential": s.potential} if s.fixed else {"current": s.current}
             if s.wall:
-                out[s.name] = dict(wall=list(self._electrode_walls[s.name]), **value)
+                place = dict(wall=list(self._electrode_walls[s.name]))
             elif s.surface is not None:
-                out[s.name] = dict(surface=self.model.surfaces[s.name].saved, **value)
+                place = dict(surface=self.model.surfaces[s.name].saved)
             else:
-                ids = self.model.memberships[s.name].ids
-                out[s.name] = dict(select=np.asarray(ids, dtype=np.int64), **value)
+                place = dict(select=np.asarray(self.model.memberships[s.name].ids, dtype=np.int64))
+            out.append(Electrode(s.name, potential=s.potential, current=s.current, **place))
         return out
 
     def _law_config(self):

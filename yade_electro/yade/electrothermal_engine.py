@@ -13,8 +13,8 @@ import numpy as np
 from ..physics.coupled import ElectroThermalModel
 from ..core.errors import BoundaryConditionError, ThermalError
 from ..core.materials import real_number
-from ..network.conditions import Convection, FixedTemperature, HeatFlux
-from ..network.conditions import HeatSource, ThermalWall
+from ..network.boundary import Condition
+from ..network.heat_conditions import ThermalWall
 from . import persistence
 from . import registry
 from .runtime import import_yade
@@ -23,7 +23,7 @@ from .scene import TemperatureWriter, write_body_attribute
 
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
-from .options import Output, Reader, thermal_settings
+from .options import HEAT_ROLES, Output, Reader, thermal_settings
 from ..physics.integrator import MODEL_OPTIONS, Integrator
 from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
@@ -100,9 +100,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                                        type(self).__name__), solver=solver, iterPeriod=iterPeriod, label=label)
 
     def _setup(self, resistivity=None, electrodes=None, density=None, specific_heat=None, conductivity=None,
-                 temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler", fixed=(),
-                 flux=(), convection=(),
-                 sources=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
+                 temperature=None, initial_temperature=None, beta=0.0, eta=1.0, theta="backward-euler",
+                 heat_conditions=(), thermal_dt=None, time_scale=1.0, steady=False, thermal_solver="cg",
                  coupled_options=None, law=None,
                  law_params=None, solver="auto", measure=None, iterPeriod: int = 1, history: Optional[str] = None,
                  history_mode: str = "w", bonds="cohesive", mask=None, geometry_every: int = 10,
@@ -164,20 +163,13 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         if not time_scale > 0:
             raise ValueError(f"time_scale must be > 0, got {time_scale}")
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
-        bcs = []
-        for group, cls in ((fixed, FixedTemperature), (flux, HeatFlux), (convection, Convection)):
-            out = []
-            for bc in group:
-                if not isinstance(bc, cls):
-                    raise TypeError(f"expected {cls.__name__} boundary conditions (yade_electro.network.transient), got {bc!r}")
-                out.append(bc if bc.nodes is None else dataclasses.replace(bc, nodes=self._normalise_selector(bc.nodes)))
-            bcs.append(out)
-        heat_sources = []
-        for src in sources:
-            if not isinstance(src, HeatSource):
-                raise TypeError(f"expected HeatSource objects (yade_electro.network.transient) in sources=, got {src!r}")
-            heat_sources.append(src if src.nodes is None else dataclasses.replace(
-                src, nodes=self._normalise_selector(src.nodes)))
+        conditions = []
+        for bc in heat_conditions:
+            if not isinstance(bc, Condition) or bc.ROLE not in HEAT_ROLES:
+                raise TypeError(f"expected heat conditions (FixedTemperature, HeatFlux, Convection, HeatSource), got "
+                                f"{bc!r}")
+            conditions.append(bc if bc.nodes is None else dataclasses.replace(
+                bc, nodes=self._normalise_selector(bc.nodes)))
         if not isinstance(steady, bool):
             raise ValueError(f"steady must be True or False, got {steady!r}")
         self.steady = steady
@@ -195,8 +187,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
                                 **{k: extra.pop(k) for k in MODEL_OPTIONS if k in extra})
         self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
-                                           integrator=integrator, fixed=bcs[0], flux=bcs[1], convection=bcs[2],
-                                           sources=heat_sources, walls=[w for w, _ in wall_specs], **extra)
+                                           integrator=integrator,
+                                           boundaries=conditions + [w for w, _ in wall_specs], **extra)
         self._last_time = float(self.O.time)
         self._temperature_writer = TemperatureWriter()
         if initial_temperature is not None and _resume is None:
@@ -328,21 +320,17 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         t["walls"] = dict(self._walls) or None
         t["skin"] = self._options["skin"]
         t["materials"] = self._materials_config
-        bcs = {}
-        for group in ("fixed", "flux", "convection"):
-            out = []
-            for bc in getattr(self.coupled, group):
-                if bc.surface is not None:
-                    out.append(dataclasses.replace(bc, surface=self.coupled.bc_surfaces[bc.name].saved))
-                else:
-                    ids = self.coupled.bc_memberships[bc.name].ids
-                    out.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
-            bcs[group] = out
-        bcs["sources"] = [src if src.nodes is None else dataclasses.replace(
-            src, nodes=np.asarray(self.coupled.bc_memberships[src.name].ids, dtype=np.int64))
-            for src in self.coupled.heat_sources]
+        saved = []
+        for bc in self.coupled.conditions + self.coupled.heat_sources:
+            if getattr(bc, "surface", None) is not None:
+                saved.append(dataclasses.replace(bc, surface=self.coupled.bc_surfaces[bc.name].saved))
+            elif bc.nodes is not None:
+                ids = self.coupled.bc_memberships[bc.name].ids
+                saved.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
+            else:
+                saved.append(bc)
         kw.update(t)
-        kw.update(bcs)
+        kw["heat_conditions"] = saved
         return kw
 
     def _save_state(self):

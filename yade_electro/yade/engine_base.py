@@ -102,14 +102,8 @@ def is_predicate(obj) -> bool:
 
 
 def electrode_walls(electrodes) -> dict:
-    """name -> body ids of the electrodes given as ``dict(wall=ids, ...)`` (granular mode)."""
-    out = {}
-    if isinstance(electrodes, dict):
-        for name, spec in electrodes.items():
-            if isinstance(spec, dict) and spec.get("wall") is not None:
-                ids = spec["wall"]
-                out[name] = [ids] if isinstance(ids, (int, np.integer)) else list(ids)
-    return out
+    """name -> body ids of the electrodes on walls (``Electrode(wall=ids)``, granular mode)."""
+    return {e.name: list(e.wall) for e in electrodes or () if getattr(e, "wall", None) is not None}
 
 
 def material_table(O, materials, allowed) -> Dict[int, Dict[str, float]]:

@@ -6,7 +6,7 @@ the starting temperatures (:class:`InitialTemperature`).
 The material (:class:`~yade_electro.core.materials.Material`), the conductance law
 (:class:`~yade_electro.laws.law.Law`), the time integration
 (:class:`~yade_electro.physics.integrator.Integrator`) and the thermal conditions
-(:class:`~yade_electro.network.conditions.FixedTemperature`, ``HeatFlux``, ``Convection``,
+(:class:`~yade_electro.network.heat_conditions.FixedTemperature`, ``HeatFlux``, ``Convection``,
 ``HeatSource``) are the core's own objects, which the models take too.
 
 Units: SI (m, V, A, K, ohm m, kg/m^3, J/(kg K), W/(m K)).
@@ -25,7 +25,7 @@ from ..laws.law import Law
 from ..network.kirchhoff import PotentialOrCurrent
 
 __all__ = ["Reader", "Output", "Electrode", "Wall", "Materials", "InitialTemperature", "electrodes_from_dict",
-           "walls_from_dict", "electrical_settings", "thermal_settings"]
+           "walls_from_dict", "electrical_settings", "thermal_settings", "HEAT_ROLES"]
 
 
 def _body_ids(what: str, ids) -> list:
@@ -178,17 +178,6 @@ class Electrode(PotentialOrCurrent):
         if self.wall is not None:
             object.__setattr__(self, "wall", tuple(_body_ids(f"Electrode {self.name!r}: wall", self.wall)))
 
-    def spec(self) -> dict:
-        """The electrode as the engine's internal ``dict(select=|surface=|wall=, potential=|current=)``."""
-        out = {}
-        for key in ("select", "surface", "potential", "current"):
-            if getattr(self, key) is not None:
-                out[key] = getattr(self, key)
-        if self.wall is not None:
-            out["wall"] = list(self.wall)
-        return out
-
-
 @dataclass(frozen=True)
 class Wall:
     """A wall of a granular bed for the heat: isothermal or adiabatic.
@@ -320,8 +309,9 @@ def _sorted_boundaries(boundaries, engine: str, allowed: tuple) -> dict:
     for b in boundaries or ():
         cls = next((c for c in allowed if isinstance(b, c)), None)
         if cls is None:
-            raise TypeError(f"{engine}: boundaries= takes {', '.join(c.__name__ for c in allowed)} objects, "
-                            f"got {b!r}")
+            said = ", ".join("FixedTemperature, HeatFlux, Convection, HeatSource (or FixedValue, Injection, Robin, "
+                             "Source)" if c.__name__ == "Condition" else c.__name__ for c in allowed)
+            raise TypeError(f"{engine}: boundaries= takes {said} objects, got {b!r}")
         groups[cls].append(b)
         names.append(b.name)
     dup = sorted({n for n in names if names.count(n) > 1})
@@ -356,17 +346,23 @@ def electrical_settings(material, boundaries, law, reader, output) -> dict:
     out = _common(law, reader, output, engine)
     if law.volume_fraction is not None:
         raise ValueError(f"{engine}: Law(volume_fraction=...) sets heat capacities; it is for the heat engines")
-    out.update(resistivity=_scalar(mat.resistivity), electrodes={e.name: e.spec() for e in groups[Electrode]},
-               materials=table)
+    out.update(resistivity=_scalar(mat.resistivity), electrodes=list(groups[Electrode]), materials=table)
     return out
+
+
+#: the roles of the boundary vocabulary a heat engine takes (besides Electrode and Wall)
+HEAT_ROLES = ("fixed", "injection", "robin", "source")
 
 
 def thermal_settings(material, boundaries, temperature, law, integrator, reader, output, engine: str) -> dict:
     """The heat engines' internal settings from their option objects."""
-    from ..network.conditions import Convection, FixedTemperature, HeatFlux, HeatSource
+    from ..network.boundary import Condition
     from ..physics.integrator import MODEL_OPTIONS, Integrator
-    groups = _sorted_boundaries(boundaries, engine, (Electrode, Wall, FixedTemperature, HeatFlux, Convection,
-                                                     HeatSource))
+    groups = _sorted_boundaries(boundaries, engine, (Electrode, Wall, Condition))
+    for c in groups[Condition]:
+        if c.ROLE not in HEAT_ROLES:
+            raise TypeError(f"{engine}: {c!r} is not a heat condition; give FixedTemperature, HeatFlux, Convection, "
+                            "HeatSource (or FixedValue, Injection, Robin, Source), and electrodes as Electrode(...)")
     electrodes = groups[Electrode]
     allowed = ("density", "specific_heat", "conductivity") + (("resistivity",) if electrodes else ())
     mat, table = _material(material, allowed, engine)
@@ -395,11 +391,11 @@ def thermal_settings(material, boundaries, temperature, law, integrator, reader,
         extra["volume_fraction"] = law.volume_fraction
     out = _common(law, reader, output, engine)
     out.update(resistivity=_scalar(mat.resistivity) if electrodes else None,
-               electrodes={e.name: e.spec() for e in electrodes} or None,
+               electrodes=list(electrodes) or None,
                density=_scalar(mat.density), specific_heat=_scalar(mat.specific_heat),
                conductivity=_scalar(mat.conductivity), temperature=T, initial_temperature=by_id,
-               beta=float(mat.beta), eta=float(integrator.eta), theta=integrator.theta, fixed=groups[FixedTemperature],
-               flux=groups[HeatFlux], convection=groups[Convection], sources=groups[HeatSource],
+               beta=float(mat.beta), eta=float(integrator.eta), theta=integrator.theta,
+               heat_conditions=list(groups[Condition]),
                thermal_dt=integrator.dt, time_scale=integrator.time_scale, steady=integrator.steady,
                thermal_solver=integrator.solver, coupled_options=extra or None,
                walls={w.name: w.spec() for w in groups[Wall]} or None, materials=table, overlap=reader.overlap)
