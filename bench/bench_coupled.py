@@ -67,8 +67,9 @@ def bench_size(n, repeat=5, seed=1):
     def model(theta, beta, law="continuum"):
         el = ElectricalModel(rod.RHO_304L, electrodes, law=law,
                              law_params={"container": container} if law == "voronoi" else None)
-        return ElectroThermalModel(el, jr.DENSITY, jr.SPECIFIC_HEAT, jr.CONDUCTIVITY, jr.T0, beta=beta,
-                                   integrator=Integrator(theta=theta))
+        material = Material(density=jr.DENSITY, specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY,
+                            beta=beta, reference_temperature=jr.T0)
+        return ElectroThermalModel(el, material, jr.T0, integrator=Integrator(theta=theta))
 
     for law in ("continuum", "voronoi"):
         suffix = "" if law == "continuum" else "_voronoi"   # put before "_ms": to_ms converts "*_ms"

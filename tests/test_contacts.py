@@ -9,6 +9,8 @@ import pytest
 from yade_electro.geometry.contacts import (WallGeometry, candidate_pairs, plane_contact_radius, triangle_distance,
                                    wall_candidates, wall_overlaps)
 from yade_electro.laws.factors import make_law
+from yade_electro import Material
+from yade_electro.laws.law import Law
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.physics.integrator import Integrator
 from yade_electro.core.errors import BoundaryConditionError
@@ -207,7 +209,8 @@ def test_softened_stiffness_correction(correction, k):
 def _sphere_on_hot_plane(theta, dt, steps, wall_conductivity=None):
     r, k, rho, c = 2e-3, 385.0, 8900.0, 172.0
     g = ContactGraph(np.zeros((1, 3)), [r], np.zeros((0, 2)))
-    m = ElectroThermalModel(None, rho, c, k, 0.0, law="contact", volume_fraction=1.0, integrator=Integrator(theta=theta),
+    m = ElectroThermalModel(None, Material(density=rho, specific_heat=c, conductivity=k), 0.0,
+                            law=Law("contact", volume_fraction=1.0), integrator=Integrator(theta=theta),
                             boundaries=[ThermalWall("plate", 100.0, wall_conductivity), ThermalWall("lid")])
     dl = 0.1e-3
     m.set_wall_contacts("plate", [0], [dl])
@@ -239,8 +242,10 @@ def test_wall_inputs_are_checked():
     with pytest.raises(BoundaryConditionError, match="names must be non-empty"):
         ThermalWall("", 300.0)
     with pytest.raises(BoundaryConditionError, match=r"walls \(ThermalWall\) given with law 'continuum'"):
-        ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="continuum", boundaries=[ThermalWall("w", 1.0)])
-    m = ElectroThermalModel(None, 1.0, 1.0, 1.0, 0.0, law="contact", boundaries=[ThermalWall("w", 1.0)])
+        ElectroThermalModel(None, Material(density=1.0, specific_heat=1.0, conductivity=1.0), 0.0, law=Law("continuum"),
+                            boundaries=[ThermalWall("w", 1.0)])
+    m = ElectroThermalModel(None, Material(density=1.0, specific_heat=1.0, conductivity=1.0), 0.0, law=Law("contact"),
+                            boundaries=[ThermalWall("w", 1.0)])
     with pytest.raises(BoundaryConditionError, match="no wall named"):
         m.set_wall_contacts("x", [0], [1e-6])
     with pytest.raises(ValueError, match="overlaps must be finite"):
@@ -332,7 +337,8 @@ def test_heat_carried_by_particles_closes_the_balance():
     C = 8900 * 172 * 4 / 3 * math.pi * r ** 3
     pos = np.array([[i * 1.9e-3, 0, 0] for i in range(4)])
     g = ContactGraph(pos, np.full(4, r), [[0, 1], [1, 2], [2, 3]], ids=[10, 11, 12, 13])
-    m = ElectroThermalModel(None, 8900, 172, 385, 300.0, law="contact", volume_fraction=1.0)
+    m = ElectroThermalModel(None, Material(density=8900, specific_heat=172, conductivity=385), 300.0,
+                            law=Law("contact", volume_fraction=1.0))
     m.restore_temperatures(lambda graph: np.array([400.0, 300.0, 300.0, 300.0]))
     start = m.refresh(g)["heat_content"]
     for _ in range(5):

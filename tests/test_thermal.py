@@ -19,6 +19,7 @@ import pytest
 
 from yade_electro import ContactGraph, MaterialError, ThermalError, solve_potential
 from yade_electro.laws.factors import conductance
+from yade_electro import Material
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.physics.integrator import Integrator
 from yade_electro.physics.electrical import ElectricalModel
@@ -302,8 +303,9 @@ def test_adiabatic_joule_heating_of_a_bar(theta, tmp_path):
     g = rod()
     V = 1e-3
     hist = History(str(tmp_path / "h.csv"))
-    m = ElectroThermalModel(electrical(potential=V), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, integrator=Integrator(theta=theta),
-                            history=hist)
+    m = ElectroThermalModel(electrical(potential=V),
+                            Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA), 293.15,
+                            integrator=Integrator(theta=theta), history=hist)
     dt = 2e-3
     for _ in range(10):
         row = m.step(g, dt)
@@ -373,7 +375,9 @@ def _resistor_model(beta, iterations, **drive):
     g = pair()
     el = ElectricalModel(RHO_E, {"a": dict(select=[0], **drive), "b": dict(select=[1], potential=0.0)},
                          solver="direct")
-    m = ElectroThermalModel(el, DENSITY, SPECIFIC_HEAT, LAMBDA, 300.0, beta=beta,
+    material = Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA, beta=beta,
+                        reference_temperature=300.0)
+    m = ElectroThermalModel(el, material, 300.0,
                             integrator=Integrator(theta="backward-euler", coupling_iterations=iterations))
     R0 = 1.0 / conductance(g, RHO_E)[0]
     C_tot = heat_capacity(g, DENSITY, SPECIFIC_HEAT).sum()
@@ -433,7 +437,8 @@ def test_resistivity_tolerance_limits_resolves():
 # ---------------------------------------------------------------------------------------------
 def test_temperatures_follow_ids_when_the_graph_changes():
     g = rod()
-    m = ElectroThermalModel(electrical(potential=1e-3), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15)
+    m = ElectroThermalModel(electrical(potential=1e-3),
+                            Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA), 293.15)
     m.step(g, 1e-3)
     T = m.temperature
     # one bond broken: a new graph, the same elements
@@ -511,7 +516,9 @@ def test_non_finite_source_or_temperature_keeps_the_state(theta):
 
 def test_coupled_model_keeps_its_history_on_thermal_error():
     g = rod()
-    m = ElectroThermalModel(electrical(potential=1e-3), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, history=History())
+    m = ElectroThermalModel(electrical(potential=1e-3),
+                            Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA), 293.15,
+                            history=History())
     m.step(g, 1e-3)
     T, t, e = m.temperature, m.time, m.joule_energy
     with warnings.catch_warnings():
@@ -533,7 +540,8 @@ def test_solver_setup_is_kept_while_dt_is_unchanged():
 
 def test_coupled_time_step_figures():
     g = rod()
-    m = ElectroThermalModel(electrical(), DENSITY, SPECIFIC_HEAT, LAMBDA, 293.15, integrator=Integrator(theta="explicit"))
+    m = ElectroThermalModel(electrical(), Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA),
+                            293.15, integrator=Integrator(theta="explicit"))
     m.step(g, 1e-4)
     ts = m.time_steps()
     assert ts["allowed"] == pytest.approx(0.9 * ts["critical"])

@@ -11,6 +11,8 @@ import pytest
 
 from yade_electro import ContactGraph
 from yade_electro.geometry.boundary import boundary_areas
+from yade_electro import Material
+from yade_electro.laws.law import Law
 from yade_electro.physics.coupled import ElectroThermalModel
 from yade_electro.core.errors import BoundaryConditionError, ThermalError
 from yade_electro.geometry.shapes import Box, Cylinder, Difference
@@ -52,7 +54,8 @@ def test_boundary_face_areas_sum_to_the_surface_area(name):
 
 
 def _heat_only(graph, **kw):
-    return ElectroThermalModel(None, RHO, CP, LAM, 300.0, law="voronoi", law_params=dict(container=ROD), **kw)
+    return ElectroThermalModel(None, Material(density=RHO, specific_heat=CP, conductivity=LAM), 300.0,
+                               law=Law("voronoi", container=ROD), **kw)
 
 
 def test_steady_state_with_one_end_held_and_the_rest_insulated_is_uniform(rod):
@@ -117,7 +120,8 @@ def test_surface_conditions_that_miss_the_boundary_are_refused(rod):
     with pytest.raises(BoundaryConditionError, match="nodes= .* or surface="):
         HeatFlux("x", power=1.0)
     with pytest.raises(ValueError, match="no Voronoi faces"):
-        ElectroThermalModel(None, RHO, CP, LAM, 300.0, law="continuum", law_params=dict(crack="facets"))
+        ElectroThermalModel(None, Material(density=RHO, specific_heat=CP, conductivity=LAM), 300.0,
+                            law=Law("continuum", crack="facets"))
 
 
 def test_a_steady_state_with_nowhere_for_the_heat_to_go_is_refused(rod):

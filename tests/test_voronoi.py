@@ -119,13 +119,14 @@ def test_cells_at_a_re_entrant_corner_are_not_cut_away():
 def test_coupled_model_takes_voronoi_cell_capacities_by_default():
     """With the voronoi law the heat capacities are rho c V_cell, from the law's own
     tessellation: they add up to rho c times the solid's volume."""
+    from yade_electro import Material
     from yade_electro.physics.coupled import ElectroThermalModel
     graph, box, L = _rod_graph(3, n=800)
     z = graph.pos[:, 2]
     el = ElectricalModel(1.0, {"top": dict(select=z > L - 0.2, potential=1.0),
                                "bottom": dict(select=z < 0.2, potential=0.0)},
                          law="voronoi", law_params=dict(container=box))
-    m = ElectroThermalModel(el, density=2.0, specific_heat=3.0, conductivity=1.0, temperature=0.0)
+    m = ElectroThermalModel(el, Material(density=2.0, specific_heat=3.0, conductivity=1.0), 0.0)
     m.step(graph, 1e-3)
     assert m.capacity.sum() == pytest.approx(2.0 * 3.0 * (1 * 1 * L), rel=1e-9)
     assert el.law.tessellations == 1                          # the capacities came from the law's tessellation

@@ -56,7 +56,7 @@ from ..core.materials import electrical_conductance, positive_property
 from .transmission import edge_transmission_surface, polyhedron_alpha
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
-           "check_law_name", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
+           "check_law_name", "needs_container", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
 
 _LAWS: Dict[str, Callable] = {}
 
@@ -87,6 +87,14 @@ def check_law_name(law) -> None:
         return
     if law not in _LAWS:
         raise KeyError(f"unknown conductance law {law!r}; known laws: {', '.join(conductance_laws())}")
+
+
+def needs_container(law) -> bool:
+    """True when the law ``law`` (a name or a law object) is bounded by the solid's container."""
+    if isinstance(law, ConductanceLaw):
+        return bool(law.needs_container)
+    check_law_name(law)
+    return bool(getattr(_LAWS[law], "needs_container", False))
 
 
 def is_contact_law(law) -> bool:

@@ -7,7 +7,7 @@ from __future__ import annotations
 from types import MappingProxyType
 from typing import Any, Mapping, Optional
 
-from .factors import check_law_name
+from .factors import check_law_name, make_law, needs_container
 
 __all__ = ["Law"]
 
@@ -85,6 +85,15 @@ class Law:
         if law is None:
             return cls()
         return cls(law)
+
+    def make(self, default: str = "continuum"):
+        """The conductance law object (:func:`~yade_electro.laws.make_law`); ``default`` for
+        ``'auto'``; the container goes to the laws bounded by it."""
+        name = default if self.name == "auto" else self.name
+        params = dict(self.params)
+        if self.container is not None and needs_container(name):
+            params["container"] = self.container
+        return make_law(name, **params)
 
     @property
     def law_params(self) -> Mapping[str, Any]:

@@ -36,7 +36,8 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..laws.factors import FactorNetwork, make_law
+from ..laws.factors import FactorNetwork
+from ..laws.law import Law
 from .electrical import ElectricalModel
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
@@ -64,18 +65,17 @@ class ElectroThermalModel:
     Parameters
     ----------
     electrical : ElectricalModel or None
-        Electrodes (voltage- or current-driven), conductance law, solver; its resistivity is
-        rho_0, the value at ``reference_temperature``. None: heat conduction only (then give
-        ``law``/``law_params``).
-    density : float or (n,) [kg/m^3]
-    specific_heat : float or (n,) [J/(kg K)]
-    conductivity : float or (n,) thermal conductivity lambda [W/(m K)]
+        Electrodes (voltage- or current-driven), conductance law, solver; it holds the
+        resistivity rho_0, the value at the material's ``reference_temperature``. None: heat
+        conduction only (then give ``law``).
+    material : Material
+        ``density`` [kg/m^3], ``specific_heat`` [J/(kg K)] and ``conductivity`` lambda
+        [W/(m K)] (scalars or one per element), ``beta`` [1/K] (rho_e(T), 0: constant) and
+        ``reference_temperature`` (T_0 of rho_e(T), needed with ``beta``, and of
+        ``heat_content``; default ``temperature``). The resistivity is the electrical model's:
+        leave it out here, or give the same value.
     temperature : float
         Initial temperature of every element [K].
-    reference_temperature : float, optional
-        T_0 of rho_e(T) and of ``heat_content``; default ``temperature``.
-    beta : float
-        Temperature coefficient of the resistivity [1/K] (0: constant resistivity).
     integrator : Integrator
         The theta method, sub-cycling, safety, the heat step's linear solver, ``eta`` (the share
         of the electrical power released as heat, paper 000 eq. 11) and the coupling to rho_e(T)
@@ -93,35 +93,52 @@ class ElectroThermalModel:
         W/m^3], shared by element volume. Walls of a granular bed are isothermal or adiabatic;
         their contacts are given before each step by :meth:`set_wall_contacts` (the YADE
         engine does it from the scene); they need a contact law ('contact', 'liggghts').
-    container : Shape, optional
-        The solid, for surface conditions (default: the electrical model's, or the law's).
+    law : Law or str, optional
+        The conductance law of a heat-only model (default ``'continuum'``); with an electrical
+        model its law is used, and ``law`` may only add ``volume_fraction`` and ``container``.
+        ``Law(volume_fraction=...)``: a scalar or ``f(graph) -> (n,)``; default paper 000's
+        fv(n) capacities, except with the 'voronoi' law, whose bounded Voronoi cell volumes
+        are used. ``Law(container=...)``: the solid, for surface conditions (default the
+        electrical model's, or the law's).
     area : callable(graph) -> (n,) exposed areas [m^2], optional
         Default area of convection/flux conditions (else ``thermal.exposed_area``).
-    volume_fraction, cell_volume : optional, see :func:`~yade_electro.network.transient.heat_capacity`
-        Scalars or callables ``f(graph) -> (n,)``. Default: paper 000's fv(n) capacities,
-        except with the 'voronoi' law, where its bounded Voronoi cell volumes are used.
-    law, law_params : conductance law of the heat-only model (``electrical=None``).
+    cell_volume : scalar or callable(graph) -> (n,), optional
+        The volume each element stands for [m^3] (see
+        :func:`~yade_electro.physics.thermal.heat_capacity`).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
     """
 
-    def __init__(self, electrical: Optional[ElectricalModel], density, specific_heat, conductivity,
-                 temperature: float, *, reference_temperature: Optional[float] = None, beta: float = 0.0,
-                 integrator: Integrator = Integrator(), boundaries: Sequence = (), area=None,
-                 volume_fraction=None, cell_volume=None, law="continuum", law_params: Optional[dict] = None,
-                 history=None, container=None):
+    def __init__(self, electrical: Optional[ElectricalModel], material: Material, temperature: float, *,
+                 integrator: Integrator = Integrator(), boundaries: Sequence = (), law=None, area=None,
+                 cell_volume=None, history=None):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.physics.electrical) or None")
+        if not isinstance(material, Material):
+            raise TypeError(f"material must be a Material(density=..., specific_heat=..., conductivity=...) "
+                            f"(yade_electro.core.materials), got {material!r}")
         self.electrical = electrical
         self.initial_temperature = real_number("temperature (K)", temperature)
-        T0 = self.initial_temperature if reference_temperature is None else reference_temperature
         rho0 = electrical.material.resistivity if electrical is not None else None
-        self.material = Material(resistivity=rho0, beta=beta, reference_temperature=T0, density=density,
-                                 specific_heat=specific_heat, conductivity=conductivity)
-        if beta != 0.0 and electrical is None:
+        if material.resistivity is not None and (rho0 is None or not np.array_equal(
+                np.asarray(material.resistivity), np.asarray(rho0))):
+            raise MaterialError("the resistivity belongs to the electrical model (ElectricalModel(resistivity=...)); "
+                                "leave it out of the heat model's material")
+        if material.beta != 0.0 and electrical is None:
             raise MaterialError("beta (rho_e(T)) needs an electrical model")
+        for name in ("density", "specific_heat", "conductivity"):
+            if getattr(material, name) is None:
+                raise MaterialError(f"the heat model needs Material(density=..., specific_heat=..., conductivity=...) "
+                                    f"(kg/m^3, J/(kg K), W/(m K)); {name} is missing")
+        T0 = self.initial_temperature if material.reference_temperature is None else material.reference_temperature
+        self.material = dataclasses.replace(material, resistivity=rho0, reference_temperature=T0)
         self.T0 = float(self.material.reference_temperature)
         self.beta = self.material.beta
+        law = Law.of(law)
+        if electrical is not None and (law.name != "auto" or law.params):
+            raise ValueError(f"the conductance law is the electrical model's ({electrical.law.name!r}); give law= "
+                             "to the ElectricalModel (Law(volume_fraction=..., container=...) may still come here)")
+        volume_fraction, container = law.volume_fraction, law.container
         if not isinstance(integrator, Integrator):
             raise TypeError(f"integrator must be an Integrator(...) (yade_electro.physics.integrator), got "
                             f"{integrator!r}")
@@ -151,8 +168,7 @@ class ElectroThermalModel:
                                     for src in self.heat_sources if src.nodes is not None})
         self.bc_surfaces = {b.name: SurfaceMembership(b.name, b.surface, what=b.KIND)
                             for b in everything if b.surface is not None}
-        self.network = electrical.network if electrical is not None else FactorNetwork(
-            make_law(law, **dict(law_params or {})))
+        self.network = electrical.network if electrical is not None else FactorNetwork(law.make())
         if self.walls:
             law_ = self.network.law
             try:

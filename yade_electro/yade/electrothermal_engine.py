@@ -12,7 +12,8 @@ import numpy as np
 
 from ..physics.coupled import ElectroThermalModel
 from ..core.errors import BoundaryConditionError, ThermalError
-from ..core.materials import real_number
+from ..core.materials import Material, real_number
+from ..laws.law import Law
 from ..network.boundary import Condition
 from ..network.heat_conditions import ThermalWall
 from . import persistence
@@ -178,17 +179,21 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                              time_scale=time_scale, thermal_solver=thermal_solver, steady=steady,
                              coupled_options=dict(coupled_options or {}), overlap=overlap)
         extra = dict(coupled_options or {})
-        if bonds == "contacts" and "cell_volume" not in extra:
-            extra.setdefault("volume_fraction", 1.0)     # a particle is its own volume
-        if self.model is None:
-            extra.setdefault("law", law)
-            extra.setdefault("law_params", self._law_params)
-        extra.setdefault("container", self.container)
+        volume_fraction = extra.pop("volume_fraction", None)
+        if bonds == "contacts" and "cell_volume" not in extra and volume_fraction is None:
+            volume_fraction = 1.0                        # a particle is its own volume
         integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
                                 **{k: extra.pop(k) for k in MODEL_OPTIONS if k in extra})
-        self._coupled = ElectroThermalModel(self.model, density, specific_heat, conductivity, temperature, beta=beta,
-                                           integrator=integrator,
-                                           boundaries=conditions + [w for w, _ in wall_specs], **extra)
+        heat_material = Material(density=density, specific_heat=specific_heat, conductivity=conductivity,
+                                 beta=beta, reference_temperature=extra.pop("reference_temperature", None))
+        if self.model is None:        # the heat-only model's own law
+            params = {k: v for k, v in (self._law_params or {}).items() if k != "container"}
+            heat_law = Law(law or "continuum", container=self.container, volume_fraction=volume_fraction, **params)
+        else:
+            heat_law = Law(container=self.container, volume_fraction=volume_fraction)
+        self._coupled = ElectroThermalModel(self.model, heat_material, temperature, integrator=integrator,
+                                           boundaries=conditions + [w for w, _ in wall_specs], law=heat_law,
+                                           **extra)
         self._last_time = float(self.O.time)
         self._temperature_writer = TemperatureWriter()
         if initial_temperature is not None and _resume is None:
