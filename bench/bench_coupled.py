@@ -51,6 +51,7 @@ WARMUP = 10         # steps before the timed ones: a live run's steady state, wh
 def bench_size(n, repeat=5, seed=1):
     yade = import_yade()
     from yade_electro.physics.coupled import ElectroThermalModel
+    from yade_electro.laws.law import Law
     from yade_electro.physics.electrical import ElectricalModel
     from yade_electro.geometry.shapes import Cylinder
     from yade_electro.yade import ElectroThermalEngine, SceneReader, Electrode, Integrator, Material
@@ -65,8 +66,7 @@ def bench_size(n, repeat=5, seed=1):
     container = Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)
 
     def model(theta, beta, law="continuum"):
-        el = ElectricalModel(rod.RHO_304L, electrodes, law=law,
-                             law_params={"container": container} if law == "voronoi" else None)
+        el = ElectricalModel(rod.RHO_304L, electrodes, law=Law(law, container=container if law == "voronoi" else None))
         material = Material(density=jr.DENSITY, specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY,
                             beta=beta, reference_temperature=jr.T0)
         return ElectroThermalModel(el, material, jr.T0, integrator=Integrator(theta=theta))

@@ -94,11 +94,13 @@ def bench_size(n, repeat=5, seed=1):
 
     # the 'voronoi' law: its first solve (one bounded tessellation: faces, cell volumes and
     # boundary faces), then the update after a bond broke (the structure is kept)
+    from yade_electro.laws.law import Law
     from yade_electro.physics.electrical import ElectricalModel
     el = {"top": dict(select=graph.index_of(ids[top]), potential=1.0),
           "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
-    model = ElectricalModel(rod.RHO_304L, el, law="voronoi",
-                            law_params=dict(container=P.as_shape(pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS))))
+    model = ElectricalModel(rod.RHO_304L, el,
+                            law=Law("voronoi", container=P.as_shape(
+                                 pack.inCylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS))))
     t = time.perf_counter()
     model.solve(graph)
     out["voronoi_first_solve_ms"] = time.perf_counter() - t

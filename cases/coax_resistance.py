@@ -31,6 +31,7 @@ HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].e
 if os.path.dirname(HERE) not in sys.path:
     sys.path.insert(0, os.path.dirname(HERE))
 
+from yade_electro.laws.law import Law  # noqa: E402
 from yade_electro.physics.electrical import ElectricalModel  # noqa: E402
 from yade_electro.geometry.shapes import Cylinder, Shape  # noqa: E402
 from yade_electro.geometry.surfaces import SurfaceSelector  # noqa: E402
@@ -100,7 +101,7 @@ def run(n=5000, seed=1, flat=False) -> dict:
     g = ContactGraph(pk.centers, pk.radii, bond_pairs(pk.centers, pk.radii))
     model = ElectricalModel(RHO, {"inner": dict(surface=wall(INNER, -1), potential=1.0),
                                   "outer": dict(surface=wall(OUTER, 1), potential=0.0)},
-                            law="voronoi", law_params=dict(container=shape))
+                            law=Law("voronoi", container=shape))
     model.solve(g)
     R, R_th = float(model.equivalent_resistance), exact_resistance()
     return {"case": "coax_resistance", "n": int(g.n_nodes), "seed": int(seed), "half_cells": "flat" if flat else

@@ -28,6 +28,7 @@ HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].e
 if os.path.dirname(HERE) not in sys.path:
     sys.path.insert(0, os.path.dirname(HERE))
 
+from yade_electro.laws.law import Law  # noqa: E402
 from yade_electro.physics.electrical import ElectricalModel  # noqa: E402
 from yade_electro.geometry.shapes import Cylinder  # noqa: E402
 from yade_electro.core.graph import ContactGraph  # noqa: E402
@@ -44,7 +45,7 @@ def single_breaks(n=1000, seed=1, breaks=89, pick_seed=0):
     for law in ("continuum", "voronoi"):
         m = ElectricalModel(0.73e-6, {"top": dict(surface=ROD.face("top"), potential=1.0),
                                       "bottom": dict(surface=ROD.face("bottom"), potential=0.0)},
-                            law=law, law_params=dict(container=ROD) if law == "voronoi" else None, container=ROD)
+                            law=Law(law, container=ROD))
         m.solve(g)
         r0 = m.equivalent_resistance
         change = []

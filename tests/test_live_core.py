@@ -9,6 +9,7 @@ import pytest
 
 from yade_electro import BoundaryConditionError, ContactGraph, Electrode, MaterialError
 from yade_electro.laws.factors import conductance
+from yade_electro.laws.law import Law
 from yade_electro.physics.electrical import ElectricalModel, ElectrodeSpec
 from yade_electro.core.history import History
 from yade_electro.core.materials import Material
@@ -117,7 +118,7 @@ def test_model_follows_moves_and_resistivity_without_rebuilding():
     g = rod()
     box = Box((-R, -R, -R), 2 * R * np.array(SHAPE) - R)
     m = ElectricalModel(RHO, {"top": dict(select=top, potential=1.0), "bottom": dict(select=bottom, potential=0.0)},
-                        solver="cg-deflated", law="voronoi", law_params=dict(container=box))
+                        solver="cg-deflated", law=Law("voronoi", container=box))
     m.solve(g)
     # a stretch along z by 1e-3: the faces keep their areas (reference tessellation), the axial
     # lengths grow, and the uniform axial current gives R up by the strain exactly

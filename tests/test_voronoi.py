@@ -4,6 +4,7 @@ import pytest
 
 from yade_electro import ContactGraph
 from yade_electro.laws.factors import conductance, make_law
+from yade_electro.laws.law import Law
 from yade_electro.physics.electrical import ElectricalModel
 from yade_electro.geometry.shapes import Box
 from yade_electro.network.conduction import equivalent_resistance
@@ -59,7 +60,7 @@ def test_cut_bonds_cut_the_current():
     graph, box, L = _rod_graph()
     z = graph.pos[:, 2]
     el = {"top": dict(select=z > L - 0.2, potential=1.0), "bottom": dict(select=z < 0.2, potential=0.0)}
-    m = ElectricalModel(1.0, el, law="voronoi", law_params=dict(container=box))
+    m = ElectricalModel(1.0, el, law=Law("voronoi", container=box))
     m.solve(graph)
     assert np.isfinite(m.equivalent_resistance)
     # break every bond crossing the plane z = L/2: no path of bonds crosses it any more
@@ -124,8 +125,7 @@ def test_coupled_model_takes_voronoi_cell_capacities_by_default():
     graph, box, L = _rod_graph(3, n=800)
     z = graph.pos[:, 2]
     el = ElectricalModel(1.0, {"top": dict(select=z > L - 0.2, potential=1.0),
-                               "bottom": dict(select=z < 0.2, potential=0.0)},
-                         law="voronoi", law_params=dict(container=box))
+                               "bottom": dict(select=z < 0.2, potential=0.0)}, law=Law("voronoi", container=box))
     m = ElectroThermalModel(el, Material(density=2.0, specific_heat=3.0, conductivity=1.0), 0.0)
     m.step(graph, 1e-3)
     assert m.capacity.sum() == pytest.approx(2.0 * 3.0 * (1 * 1 * L), rel=1e-9)

@@ -26,7 +26,8 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..laws.factors import ConductanceLaw, FactorNetwork, make_law
+from ..laws.factors import ConductanceLaw, FactorNetwork
+from ..laws.law import Law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
 from ..core.materials import Material, electrical_conductance, positive_property
@@ -111,14 +112,15 @@ class ElectricalModel:
 
     Parameters
     ----------
-    resistivity : float or (n,) array, or Material
-        Electrical resistivity rho_e [ohm m], > 0 (304L steel: 0.73e-6), or a Material.
-    electrodes : mapping name -> dict(select=..., potential=V | current=A), or ElectrodeSpecs
-    law : str or ConductanceLaw
-        Conductance law name (``yade_electro.laws.factors.conductance_laws()``).
-    law_params : dict, optional
-        Parameters of the law (``container`` for 'voronoi'; ``threshold``, ``factor`` for
-        'continuum').
+    material : Material, or float or (n,) array
+        ``Material(resistivity=...)``, or the electrical resistivity rho_e [ohm m] itself, > 0
+        (304L steel: 0.73e-6). The model holds it (rho_0 of rho_e(T) in a coupled model).
+    electrodes : sequence of ElectrodeSpec, or mapping name -> dict(select=..., potential=V | current=A)
+    law : Law, str or ConductanceLaw
+        The conductance law (default ``'continuum'``): ``Law('voronoi', container=shape)``,
+        ``Law('continuum', threshold=0.4)``, a name of
+        ``yade_electro.laws.factors.conductance_laws()``, or a law object. The Law's
+        ``container`` is the solid, for surface electrodes (default: the 'voronoi' law's).
     solver : str or solver object
         'auto' (by size), 'cg', 'cg-deflated', 'cg-amg', 'direct' or an object with
         ``solve(A, b, x0=None) -> (x, info)`` (see :mod:`yade_electro.solvers.registry`).
@@ -127,13 +129,11 @@ class ElectricalModel:
     reselect : bool
         Re-evaluate the electrode selectors on every new structure instead of keeping the
         elements chosen the first time (by id).
-    container : Shape, optional
-        The solid's container, for surface electrodes (default: the 'voronoi' law's).
     """
 
-    def __init__(self, resistivity, electrodes, law="continuum", law_params: Optional[dict] = None,
-                 solver="auto", measure: Optional[Sequence[str]] = None, reselect: bool = False, container=None):
-        self.material = resistivity if isinstance(resistivity, Material) else Material(resistivity=resistivity)
+    def __init__(self, material, electrodes, *, law=None, solver="auto", measure: Optional[Sequence[str]] = None,
+                 reselect: bool = False):
+        self.material = material if isinstance(material, Material) else Material(resistivity=material)
         self.material.require_electrical()
         self.specs = electrode_specs(electrodes)
         if not self.specs:
@@ -142,7 +142,12 @@ class ElectricalModel:
         if len(set(names)) != len(names):
             raise BoundaryConditionError(f"electrode names must be unique, got {names}")
         check_solver_name(solver)
-        self.law: ConductanceLaw = make_law(law, **dict(law_params or {}))
+        container = None
+        if isinstance(law, ConductanceLaw):
+            self.law: ConductanceLaw = law
+        else:
+            law = Law.of(law)
+            self.law, container = law.make(), law.container
         self.solver = solver
         if measure is None:
             measure = names[:2] if len(names) >= 2 else None

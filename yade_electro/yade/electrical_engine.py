@@ -34,6 +34,7 @@ from typing import Dict, Optional
 
 import numpy as np
 
+from ..laws.law import Law
 from ..physics.electrical import ElectricalModel, ElectrodeSpec
 from ..core.errors import BoundaryConditionError
 from ..geometry.shapes import Shape, as_shape
@@ -161,8 +162,10 @@ class ElectricalEngine(EngineBase):
                                        surface=e.surface, wall=e.wall is not None, potential=e.potential,
                                        current=e.current))
         self._resistivity = resistivity
-        return ElectricalModel(resistivity, specs, law=law, law_params=law_params, solver=solver, measure=measure,
-                               reselect=reselect, container=self.container)
+        params = dict(law_params or {})
+        law_container = params.pop("container", None)
+        law = Law(law, container=self.container if law_container is None else law_container, **params)
+        return ElectricalModel(resistivity, specs, law=law, solver=solver, measure=measure, reselect=reselect)
 
     # -- persistence ---------------------------------------------------------------------------
     def _electrode_config(self) -> list:
