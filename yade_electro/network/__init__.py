@@ -14,6 +14,7 @@ from .floating import (floating_message, warn_floating, no_steady_state_message,
 from .kirchhoff import (laplacian, network_components, electrode_value, edge_power, PotentialOrCurrent,
                         Electrode)
 from .records import PotentialSolution, ThermalState, HeatStep, SteadyHeat, read_only_copy
+from .structure import Words, GENERIC_WORDS, NetworkStructure
 from .theta import theta_of, stable_time_step, THETA_NAMES
 from .transient import HeatSolver
 
@@ -24,4 +25,5 @@ __all__ = ["boundary_value", "check_place", "check_area", "Condition", "FixedVal
            "floating_message", "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",
            "solve_with_floating", "laplacian", "network_components", "electrode_value", "edge_power",
            "PotentialOrCurrent", "Electrode", "PotentialSolution", "ThermalState", "HeatStep", "SteadyHeat",
-           "read_only_copy", "theta_of", "stable_time_step", "THETA_NAMES", "HeatSolver"]
+           "read_only_copy", "Words", "GENERIC_WORDS", "NetworkStructure", "theta_of", "stable_time_step", "THETA_NAMES",
+           "HeatSolver"]

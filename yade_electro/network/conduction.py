@@ -57,11 +57,13 @@ from .condensation import ReducedSystem
 from .floating import warn_floating
 from .kirchhoff import Electrode, electrode_value, network_components
 from .records import PotentialSolution
-from ..core.errors import BoundaryConditionError, MaterialError, SolverError
-from ..core.graph import edge_slots
-from ..solvers.registry import make_solver
+from .structure import NetworkStructure, Words
+from ..core.errors import BoundaryConditionError, SolverError
 
-__all__ = ["ConductionProblem", "solve_potential", "equivalent_resistance"]
+__all__ = ["ConductionProblem", "solve_potential", "equivalent_resistance", "ELECTRICAL_WORDS"]
+
+#: the electrical words of a network's messages
+ELECTRICAL_WORDS = Words(conductance="conductances must be finite and >= 0 (check resistivity and radii)")
 
 log = logging.getLogger(__name__)
 
@@ -72,7 +74,7 @@ def _ro(a):
     return a
 
 
-class ConductionProblem:
+class ConductionProblem(NetworkStructure):
     """Kirchhoff network with electrodes, kept for repeated solves (see module doc).
 
     Building it checks the electrodes and the connected parts. Then:
@@ -98,13 +100,12 @@ class ConductionProblem:
     coords : (n, 3) node positions [m], optional (for the coarse space of 'cg-deflated')
     """
 
+    WORDS = ELECTRICAL_WORDS
+
     def __init__(self, n_nodes: int, edges, conductance, electrodes: Sequence[Electrode],
                  injection=None, solver="auto", coords=None):
-        self.n = n = int(n_nodes)
-        self.edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        if self.edges.size and (self.edges.min() < 0 or self.edges.max() >= n):
-            raise ValueError(f"edge node index out of range 0..{n - 1}")
-        self.c = self._check_conductance(conductance)
+        self._init_structure(n_nodes, edges, conductance, solver, coords)
+        n = self.n
         self.electrodes = list(electrodes)
         for e in self.electrodes:
             if getattr(e, "ROLE", None) != "terminal" or getattr(e, "nodes", None) is None:
@@ -136,10 +137,6 @@ class ConductionProblem:
             if f.shape != (n,) or not np.all(np.isfinite(f)):
                 raise BoundaryConditionError(f"injection must be a finite array of shape ({n},)")
             self.injection = f if np.any(f != 0) else None
-        self.coords = None if coords is None else np.asarray(coords, dtype=float)
-        self._solver_spec = solver
-        self.solver = None
-        self.structure_builds = 0
         self.value_updates = 0
         self.basis_solves = 0
         self._phi = None                 # (nu, ne) characteristic potentials, warm start
@@ -147,13 +144,10 @@ class ConductionProblem:
         self._check_return_paths([e.amount for e in self.electrodes])
 
     # -- structure ------------------------------------------------------------------------
-    def _check_conductance(self, conductance):
-        c = np.asarray(conductance, dtype=float)
-        if c.shape != (self.edges.shape[0],):
-            raise ValueError(f"conductance must have one value per edge ({self.edges.shape[0]}), got {c.shape}")
-        if not np.all(np.isfinite(c)) or np.any(c < 0):
-            raise MaterialError("conductances must be finite and >= 0 (check resistivity and radii)")
-        return c
+    @property
+    def c(self) -> np.ndarray:
+        """The conductances [S] (one per edge)."""
+        return self.conductance
 
     def _components(self, c):
         """Connected parts through conducting edges, electrodes counted as super-nodes."""
@@ -183,12 +177,7 @@ class ConductionProblem:
             ncl = np.unique(node_label[exclude]).size
             warn_floating(nfl, ncl, "electrode", "a potential of 0 V", stacklevel=5)
         nu = self.system.n_unknowns
-        if self.solver is None or isinstance(self._solver_spec, str):
-            self.solver = make_solver(self._solver_spec, n_unknowns=nu)
-        if self.coords is not None:
-            X = self.coords[self.system.unknown_nodes]
-            spacing = self._spacing()
-            self.solver.set_geometry(X, spacing)
+        self._kept_solver(self.system.unknown_nodes, self.edges[self.c > 0])
         # warm start carried over through node potentials
         if old_phi is not None and old_sys is not None:
             phi = np.zeros((nu, len(self.electrodes)))
@@ -210,19 +199,12 @@ class ConductionProblem:
         self._part_unknowns = {lab: np.flatnonzero(ulab == lab) for lab in self._parts}
         self.component_of_electrode = {e.name: int(el_label[k]) for k, e in enumerate(self.electrodes)}
 
-    def _spacing(self):
-        e = self.edges[self.c > 0]
-        if e.size == 0:
-            return None
-        d = self.coords[e[:, 1]] - self.coords[e[:, 0]]
-        return float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d))))
-
     def update_conductance(self, conductance) -> str:
         """New conductances on the same edges [S]. Returns 'values' (in-place update, solver
         setup kept) or 'structure' (the connected parts changed: rebuilt)."""
         c = self._check_conductance(conductance)
         same_parts = np.array_equal(c > 0, self.c > 0)
-        self.c = c
+        self.conductance = c
         self._last = None
         self._basis_valid = False
         if not same_parts:
@@ -254,13 +236,11 @@ class ConductionProblem:
         c_new = np.asarray(conductance, dtype=float)
         if c_new.shape != (edges.shape[0],):
             raise ValueError(f"conductance must have one value per edge ({edges.shape[0]}), got {c_new.shape}")
-        slots = edge_slots(self.edges, edges, self.n)
-        if slots is not None:
-            c = np.zeros(self.edges.shape[0])
-            c[slots] = c_new
-            return self.update_conductance(c)
+        full = self._on_subset(edges, c_new)
+        if full is not None:
+            return self.update_conductance(full)
         self.edges = edges
-        self.c = self._check_conductance(c_new)
+        self.conductance = self._check_conductance(c_new)
         self._build()
         return "structure"
 

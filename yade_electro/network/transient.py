@@ -32,8 +32,8 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from ..core.errors import BoundaryConditionError, MaterialError, SolverError, ThermalError
-from ..core.graph import ContactGraph, edge_slots
+from ..core.errors import BoundaryConditionError, SolverError, ThermalError
+from ..core.graph import ContactGraph
 from ..core.materials import positive_property
 from ..laws.transmission import exposed_area
 from ..solvers.cg import CGSolver
@@ -44,11 +44,15 @@ from .boundary import boundary_value
 from .resolution import resolve_conditions
 from .floating import floating_parts, solve_with_floating
 from .records import HeatStep, SteadyHeat, ThermalState, read_only_copy as _ro
+from .structure import NetworkStructure, Words
 from .theta import theta_of
 
 _OWN_SOLVERS = (CGSolver, DirectSolver)
 
-__all__ = ["HeatSolver"]
+__all__ = ["HeatSolver", "THERMAL_WORDS"]
+
+#: the thermal words of a network's messages
+THERMAL_WORDS = Words(conductance="thermal conductances must be finite and >= 0 (W/K); check the conductivity")
 
 log = logging.getLogger(__name__)
 
@@ -57,7 +61,7 @@ log = logging.getLogger(__name__)
 # ---------------------------------------------------------------------------------------
 # the integrator
 # ---------------------------------------------------------------------------------------
-class HeatSolver:
+class HeatSolver(NetworkStructure):
     """Lumped heat conduction on a network, advanced step by step with the theta method.
 
     The structure (the fixed-temperature sets condensed out, the sparsity pattern, the linear
@@ -117,6 +121,7 @@ class HeatSolver:
     """
 
     RTOL = 1e-12
+    WORDS = THERMAL_WORDS
 
     def __init__(self, capacity, edges, conductance, temperature, *, conditions: Sequence = (), theta="backward-euler",
                  subcycle: bool = True, safety: float = 0.9, max_substeps: int = 100000, solver="cg",
@@ -127,16 +132,12 @@ class HeatSolver:
         n = C.shape[0]
         if graph is not None and graph.n_nodes != n:
             raise ValueError(f"the graph has {graph.n_nodes} nodes, capacity {n}")
-        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        if edges.size and (edges.min() < 0 or edges.max() >= n):
-            raise ValueError(f"edge node index out of range 0..{n - 1}")
+        self._init_structure(n, edges, conductance, solver, coords)
         self.theta = theta_of(theta)
         if not (0.0 < safety <= 1.0):
             raise ValueError(f"safety must be in (0, 1], got {safety}")
         self.subcycle, self.safety, self.max_substeps = bool(subcycle), float(safety), int(max_substeps)
-        self.n, self.graph = n, graph
-        self.edges = edges
-        G = self._check_conductance(conductance, edges.shape[0])
+        self.graph = graph
         default_area = area if area is not None else (exposed_area(graph) if graph is not None else None)
         if default_area is not None:
             default_area = np.asarray(default_area, dtype=float)
@@ -156,12 +157,8 @@ class HeatSolver:
         self._refresh_links()
         self.nodes_of = r.nodes_of
 
-        self._solver_spec = solver
-        self._coords = None if coords is None else np.asarray(coords, dtype=float)
-        self._solver = None
-        self.structure_builds = 0
         self.capacity = _ro(C)
-        self.conductance = _ro(G)
+        self.conductance = _ro(self.conductance)
         self._build_structure()
 
         T = np.broadcast_to(np.asarray(temperature, dtype=float), (n,)).copy()
@@ -188,30 +185,13 @@ class HeatSolver:
         positive_property("heat capacity", C, C.shape[0], " (J/K)")
         return C
 
-    @staticmethod
-    def _check_conductance(conductance, m):
-        G = np.asarray(conductance, dtype=float)
-        if G.shape != (m,):
-            raise ValueError(f"conductance must have one value per edge ({m}), got {G.shape}")
-        if not np.all(np.isfinite(G)) or np.any(G < 0):
-            raise MaterialError("thermal conductances must be finite and >= 0 (W/K); check the conductivity")
-        return G
-
     def _build_structure(self):
         groups = [self._fixed_nodes[b.name] for b in self.fixed_bcs if b.name in self._fixed_nodes]
         self.system = ReducedSystem(self.n, self.edges, groups)
         self._u = self.system.unknown_nodes
         self._d = np.flatnonzero(self.fixed)
-        nu = self._u.size
-        if self._solver is None or isinstance(self._solver_spec, str):
-            self._solver = make_solver(self._solver_spec, n_unknowns=nu,
-                                       **({"rtol": self.RTOL} if isinstance(self._solver_spec, str)
-                                          and self._solver_spec != "direct" else {}))
-        if self._coords is not None and nu:
-            e = self.edges
-            d = self._coords[e[:, 1]] - self._coords[e[:, 0]]
-            spacing = float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d)))) if e.size else None
-            self._solver.set_geometry(self._coords[self._u], spacing)
+        self._kept_solver(self._u, self.edges, **({"rtol": self.RTOL} if isinstance(self._solver_spec, str)
+                                                   and self._solver_spec != "direct" else {}))
         self._A = None
         self._A_key = None
         self._dT_prev = None
@@ -232,7 +212,7 @@ class HeatSolver:
         """New conductances (same edges) [W/K] and/or capacities [J/K], in place: the structure
         and the solver setup are kept."""
         if conductance is not None:
-            self.conductance = _ro(self._check_conductance(conductance, self.edges.shape[0]))
+            self.conductance = _ro(self._check_conductance(conductance))
         if capacity is not None:
             C = self._check_capacity(capacity)
             if C.shape != (self.n,):
@@ -245,10 +225,8 @@ class HeatSolver:
         one rebuilds it ('structure'); temperatures, time and energies are kept."""
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
         G = self._check_conductance(conductance, edges.shape[0])
-        slots = edge_slots(self.edges, edges, self.n)
-        if slots is not None:
-            full = np.zeros(self.edges.shape[0])
-            full[slots] = G
+        full = self._on_subset(edges, G)
+        if full is not None:
             self.update_values(full, capacity)
             return "values"
         self.edges = edges
@@ -285,11 +263,6 @@ class HeatSolver:
         (default the current one): sum_i G_i (T_s - T_i)."""
         T = self._T if temperature is None else np.asarray(temperature, dtype=float)
         return {k: float(np.sum(g * (self._fixed_value[k] - T[nd]))) for k, (nd, g) in self._links.items()}
-
-    @property
-    def solver(self):
-        """The linear solver of the implicit steps (kept while the structure is)."""
-        return self._solver
 
     # -- state -----------------------------------------------------------------------------------
     def _apply_fixed(self, T):
@@ -559,11 +532,8 @@ class HeatSolver:
         elif u.size:
             if getattr(self, "_steady_solver", None) is None or self._steady_key != id(self.system):
                 self._steady_solver = make_solver("auto", n_unknowns=u.size, rtol=rtol)
-                if self._coords is not None:
-                    e = self.edges
-                    d = self._coords[e[:, 1]] - self._coords[e[:, 0]]
-                    spacing = float(np.mean(np.sqrt(np.einsum("ij,ij->i", d, d)))) if e.size else None
-                    self._steady_solver.set_geometry(self._coords[u], spacing)
+                if self.coords is not None:
+                    self._steady_solver.set_geometry(self.coords[u], self._mean_length(self.edges))
                 self._steady_key = id(self.system)
                 self._steady_A = None
             if self._steady_A is None:
