@@ -42,20 +42,16 @@ def test_triangle_distance_against_dense_sampling():
     assert np.max(brute - got) < 5e-3                     # the sampling's resolution
 
 
-def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
+def test_compiled_contact_radii_are_the_numpy_ones():
     """The contact radii of native/contact_radii.cpp against the numpy form, both models, on
     overlapping and separated pairs of a polydisperse cloud, with and without periodic image
     shifts: the same a^2 to 1e-14 r_max^2 (a last-bit difference in the centre distance, numpy's
     einsum sums the squares in another order, is amplified in a^2 = r1^2 - x^2 for small
-    contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way."""
-    import yade_electro.geometry.contacts as C
+    contacts, to about 1e-13 relative in a); coincident centres are a MaterialError either way,
+    and other pairs than a periodic graph's edges (numpy in the package) agree too."""
+    import reference_kernels as ref
     from yade_electro.laws.factors import contact_radius, edge_lengths
     from yade_electro.core.errors import MaterialError
-    from yade_electro.native import NativeError, contact_radii
-    try:
-        contact_radii(np.zeros((1, 3)), np.ones(1), np.zeros((0, 2), dtype=np.int64))
-    except NativeError as exc:
-        pytest.skip(f"the compiled helper does not build here: {exc}")
     rng = np.random.default_rng(11)
     pos = rng.uniform(0, 0.01, (500, 3))
     rad = rng.uniform(0.4e-3, 1.2e-3, 500)
@@ -63,37 +59,36 @@ def test_compiled_contact_radii_are_the_numpy_ones(monkeypatch):
     shift = rng.uniform(-1e-4, 1e-4, (edges.shape[0], 3))
     for g in (ContactGraph(pos, rad, edges), ContactGraph(pos, rad, edges, shift=shift)):
         for model in ("geometric", "hertz"):
-            monkeypatch.setattr(C, "NATIVE", True)
             fast = contact_radius(g, model=model)
-            monkeypatch.setattr(C, "NATIVE", False)
-            slow = contact_radius(g, model=model)
+            slow = ref.contact_radius(g, model=model)
             assert np.count_nonzero(slow) > 100 and np.count_nonzero(slow == 0) > 100
             assert np.array_equal(fast == 0, slow == 0)
             assert np.allclose(fast ** 2, slow ** 2, rtol=0, atol=1e-14 * rad.max() ** 2)
+        # pairs that are not the periodic graph's edges take the package's numpy path
+        other = edges[::7].copy()
+        assert np.allclose(contact_radius(g, other) ** 2, ref.contact_radius(g, other) ** 2, rtol=0,
+                           atol=1e-14 * rad.max() ** 2)
     same = ContactGraph([[0, 0, 0], [0, 0, 0]], [1.0, 1.0], [[0, 1]])
-    for native in (True, False):
-        monkeypatch.setattr(C, "NATIVE", native)
+    same_periodic = ContactGraph([[0, 0, 0], [0, 0, 0]], [1.0, 1.0], [[0, 1]], shift=np.zeros((1, 3)))
+    for graph, pairs in ((same, same.edges), (same_periodic, same_periodic.edges.copy())):
         with pytest.raises(MaterialError, match="coincident"):
-            contact_radius(same)
+            contact_radius(graph, pairs)
         with pytest.raises(MaterialError, match="coincident"):
-            edge_lengths(same, same.edges)
+            edge_lengths(graph, pairs)
     # the centre distances (native pair_lengths), of the graph's edges and of other pairs
     g = ContactGraph(pos, rad, edges, shift=shift)
     other = np.array([[0, 5], [7, 3], [499, 0]])
-    for graph, pairs in ((g, g.edges), (ContactGraph(pos, rad, edges), other)):
-        monkeypatch.setattr(C, "NATIVE", True)
-        fast = edge_lengths(graph, pairs)
-        monkeypatch.setattr(C, "NATIVE", False)
-        slow = edge_lengths(graph, pairs)
-        assert np.allclose(fast, slow, rtol=1e-15, atol=0)
+    for graph, pairs in ((g, g.edges), (ContactGraph(pos, rad, edges), other), (g, edges[::7].copy())):
+        assert np.allclose(edge_lengths(graph, pairs), ref.edge_lengths(graph, pairs), rtol=1e-15, atol=0)
 
 
-def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
+def test_compiled_contacts_are_the_numpy_ones():
     """The compiled helpers (native/wall_contacts.cpp, the cell grid of fire_steps.cpp) against
     the numpy / cKDTree forms: triangle distances in every closest-point region (the same to
     1e-15 relative; exactly on the degenerate cases), the Verlet list and a facet mesh's
     candidates identical; the deepest overlaps the same from sorted or shuffled candidates; a
     sparse box (a sphere far away) goes to the tree."""
+    import reference_kernels as ref
     import yade_electro.geometry.contacts as C
     rng = np.random.default_rng(8)
     k = 4000
@@ -102,7 +97,7 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     pts = rng.uniform(-2, 2, (k, 3))
     pts[50:100] = tri[50:100, 0]                                # exactly on a corner
     fast = C.triangle_distance(pts, tri)
-    slow = C._triangle_distance_numpy(pts, tri)
+    slow = ref.triangle_distance(pts, tri)
     ok = np.isfinite(slow)
     assert np.all(ok[100:]) and np.allclose(fast[ok], slow[ok], rtol=1e-14, atol=1e-15)
     assert np.all(fast[50:100] == 0.0)
@@ -120,9 +115,9 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     pos = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), rng.uniform(0, 0.02, 1500)])
     got_w = C.wall_candidates(wall, pos, r, 1e-3)
     got_p = C.candidate_pairs(pos, r, 1e-3)
-    monkeypatch.setattr(C, "NATIVE", False)
-    ref_w = C.wall_candidates(wall, pos, r, 1e-3)
-    ref_p = C.candidate_pairs(pos, r, 1e-3)
+    tree = C.sphere_tree(pos)                       # given a tree, both searches query it
+    ref_w = C.wall_candidates(wall, pos, r, 1e-3, tree=tree)
+    ref_p = C.candidate_pairs(pos, r, 1e-3, tree=tree)
     assert got_w[0].size > 100 and all(np.array_equal(a, b) for a, b in zip(got_w, ref_w))
     assert got_p.shape[0] > 1000 and np.array_equal(got_p, ref_p)
     # the deepest overlap per sphere: sorted candidates (reduceat) or not (np.unique) alike
@@ -132,16 +127,16 @@ def test_compiled_contacts_are_the_numpy_ones(monkeypatch):
     assert touching[0].size > 10
     assert all(np.array_equal(a, b) for a, b in zip(touching, C.wall_overlaps(wall, pos_in, r, ref_w[0][shuffle],
                                                                                  ref_w[1][shuffle])))
-    monkeypatch.setattr(C, "NATIVE", True)
     far = np.vstack([pos, [[100.0, 0, 0]]])
     assert C._cell_pairs(far, 5e-3) is None
     assert np.array_equal(C.candidate_pairs(far, np.append(r, 2e-3), 1e-3), ref_p)
 
 
-def test_facet_vertices_compiled_numpy_and_scipy_rotation_agree(monkeypatch):
+def test_facet_vertices_compiled_numpy_and_scipy_rotation_agree():
     """The facets' world vertices from their poses: the compiled pass, the numpy form and
     scipy's Rotation (a reference we did not write) on random unit quaternions."""
     from scipy.spatial.transform import Rotation
+    import reference_kernels as ref
     import yade_electro.geometry.contacts as C
     rng = np.random.default_rng(11)
     k = 500
@@ -150,8 +145,7 @@ def test_facet_vertices_compiled_numpy_and_scipy_rotation_agree(monkeypatch):
     pos = rng.uniform(-0.1, 0.1, (k, 3))
     local = rng.uniform(-0.01, 0.01, (k, 3, 3))
     fast = C.facet_vertices(pos, q, local)
-    monkeypatch.setattr(C, "NATIVE", False)
-    slow = C.facet_vertices(pos, q, local)
+    slow = ref.facet_vertices(pos, q, local)
     ref = pos[:, None, :] + np.stack([Rotation.from_quat(q).apply(local[:, v]) for v in range(3)], axis=1)
     assert fast.shape == (k, 3, 3)
     assert np.abs(fast - slow).max() <= 4e-17, np.abs(fast - slow).max()      # a few ulps of 0.1 m

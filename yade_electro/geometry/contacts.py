@@ -185,20 +185,16 @@ _CELLS = []
 
 def _cell_pairs(pos, cut):
     """Every pair closer than ``cut`` by the compiled cell grid (``FireSteps.pairs_within``),
-    or None (no compiler, a grid too fine for the box, ``NATIVE = False``): then cKDTree."""
-    if not NATIVE:
-        return None
+    or None for a sparse box (spheres far apart, a grid with far more cells than spheres):
+    there cKDTree is the better search."""
     span = np.ptp(pos, axis=0) if pos.shape[0] else np.zeros(3)
     cells = np.prod(np.maximum(1.0, np.floor(span / cut)))
     if not np.isfinite(cells) or cells > 8 * pos.shape[0] + 4096:
-        return None                      # a sparse box (spheres far apart): the tree is better
-    from ..native import FireSteps, NativeError
-    try:
-        if not _CELLS:
-            _CELLS.append(FireSteps(threads=1))
-        return _CELLS[0].pairs_within(np.ascontiguousarray(pos, dtype=np.float64), cut)
-    except NativeError:
         return None
+    from ..native import FireSteps
+    if not _CELLS:
+        _CELLS.append(FireSteps(threads=1))
+    return _CELLS[0].pairs_within(np.ascontiguousarray(pos, dtype=np.float64), cut)
 
 
 def max_displacement(pos, pos0) -> float:
@@ -290,20 +286,6 @@ class WallGeometry:
         return float(abs((self.point - other.point) @ self.normal))
 
 
-def native_helper(name):
-    """The compiled helper ``name`` of :mod:`yade_electro.native`, or None (numpy) when it
-    cannot be built or is switched off (``NATIVE = False``, for tests)."""
-    if not NATIVE:
-        return None
-    from .. import native
-    return getattr(native, name)
-
-
-#: use the compiled helpers (``native/wall_contacts.cpp``, ``fire_steps.cpp``'s cell grid,
-#: ``contact_radii.cpp``) where they build; False: numpy and scipy's cKDTree only
-NATIVE = True
-
-
 def quaternion_matrices(q) -> np.ndarray:
     """Rotation matrices (k, 3, 3) of unit quaternions (k, 4) stored (x, y, z, w), as YADE's
     ``Quaternion[i]`` gives them."""
@@ -321,73 +303,19 @@ def facet_vertices(pos, quat, local) -> np.ndarray:
     plus the rotation of unit quaternion ``quat`` (k, 4), stored (x, y, z, w), applied to
     the vertices in the body frame ``local`` (k, 3, 3) [m]. Compiled
     (:func:`yade_electro.native.facet_vertices`: 96 facets of the drum in a few
-    microseconds, where these numpy operations take about 0.2 ms) where it builds."""
-    f = native_helper("facet_vertices")
-    if f is not None:
-        from ..native import NativeError
-        try:
-            return f(pos, quat, local)
-        except NativeError:
-            pass
-    return _facet_vertices_numpy(pos, quat, local)
-
-
-def _facet_vertices_numpy(pos, quat, local):
-    R = quaternion_matrices(quat)
-    return np.asarray(pos, float)[:, None, :] + np.einsum("kij,kvj->kvi", R, np.asarray(local, float))
+    microseconds, where numpy's operations take about 0.2 ms; the numpy form is the tests'
+    reference)."""
+    from ..native import facet_vertices as compiled
+    return compiled(pos, quat, local)
 
 
 def triangle_distance(points, triangles) -> np.ndarray:
     """Distance [m] from each point (k, 3) to the triangle (k, 3, 3) of the same row (the
     closest point of the triangle, faces, edges or corners; Ericson, Real-Time Collision
-    Detection, 5.1.5). Compiled (:func:`yade_electro.native.triangle_distance`, the same
-    regions and precedence) where it builds, else numpy."""
-    f = native_helper("triangle_distance")
-    if f is not None:
-        from ..native import NativeError
-        try:
-            return f(points, triangles)
-        except NativeError:
-            pass
-    return _triangle_distance_numpy(points, triangles)
-
-
-def _triangle_distance_numpy(points, triangles) -> np.ndarray:
-    p = np.asarray(points, float)
-    t = np.asarray(triangles, float)
-    a, b, c = t[:, 0], t[:, 1], t[:, 2]
-    ab, ac, ap = b - a, c - a, p - a
-
-    def dot(u, v):
-        return np.einsum("ij,ij->i", u, v)
-    d1, d2 = dot(ab, ap), dot(ac, ap)
-    bp = p - b
-    d3, d4 = dot(ab, bp), dot(ac, bp)
-    cp = p - c
-    d5, d6 = dot(ab, cp), dot(ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        denom = va + vb + vc
-        v = vb / denom
-        w = vc / denom
-        q = a + v[:, None] * ab + w[:, None] * ac                  # inside the face
-        # edges
-        t_ab = d1 / (d1 - d3)
-        t_ac = d2 / (d2 - d6)
-        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-    on_ab = (vc <= 0) & (d1 >= 0) & (d3 <= 0)
-    on_ac = (vb <= 0) & (d2 >= 0) & (d6 <= 0)
-    on_bc = (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)
-    q = np.where(on_bc[:, None], b + t_bc[:, None] * (c - b), q)
-    q = np.where(on_ac[:, None], a + t_ac[:, None] * ac, q)
-    q = np.where(on_ab[:, None], a + t_ab[:, None] * ab, q)
-    # corners
-    q = np.where(((d6 >= 0) & (d5 <= d6))[:, None], c, q)
-    q = np.where(((d3 >= 0) & (d4 <= d3))[:, None], b, q)
-    q = np.where(((d1 <= 0) & (d2 <= 0))[:, None], a, q)
-    return np.sqrt(((p - q) ** 2).sum(axis=1))
+    Detection, 5.1.5). Compiled (:func:`yade_electro.native.triangle_distance`; the numpy form
+    with the same regions and precedence is the tests' reference)."""
+    from ..native import triangle_distance as compiled
+    return compiled(points, triangles)
 
 
 def _distance(wall: WallGeometry, pos, piece):
@@ -412,14 +340,10 @@ def wall_candidates(wall: WallGeometry, pos, radius, skin: float, tree=None):
         return s, np.zeros(s.size, dtype=np.int64)
     c, rc = wall.reach()
     reach = rc + float(radius.max()) + float(skin)
-    f = native_helper("triangle_candidates")
-    if f is not None and tree is None:
-        from ..native import NativeError
-        try:
-            return f(pos, radius, skin, wall.vertices, c, reach)
-        except NativeError:
-            pass
-    tree = sphere_tree(pos) if tree is None else tree
+    if tree is None:              # compiled: a grid of the spheres
+        from ..native import triangle_candidates
+        return triangle_candidates(pos, radius, skin, wall.vertices, c, reach)
+    # a tree of the spheres is already made (the sphere pairs' search): query it
     lists = tree.query_ball_point(c, reach)
     pieces = np.repeat(np.arange(len(lists)), [len(x) for x in lists])
     spheres = np.fromiter((i for x in lists for i in x), dtype=np.int64, count=pieces.size)

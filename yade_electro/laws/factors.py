@@ -49,7 +49,6 @@ from typing import Callable, Dict
 
 import numpy as np
 
-from ..geometry.contacts import native_helper
 from ..core.errors import MaterialError
 from ..core.graph import ContactGraph
 from ..core.materials import electrical_conductance, positive_property
@@ -131,19 +130,19 @@ def make_law(law="continuum", **params) -> "ConductanceLaw":
 
 def edge_lengths(graph: ContactGraph, edges) -> np.ndarray:
     """Centre-to-centre distance of node pairs [m]; MaterialError for coincident centres.
-    Compiled (:func:`yade_electro.native.pair_lengths`) where it builds, else numpy."""
+    Compiled (:func:`yade_electro.native.pair_lengths`); other pairs than the edges of a
+    periodic graph (whose shifts the graph does not hold) by :meth:`ContactGraph.edge_vectors`."""
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    f = native_helper("pair_lengths")
-    if f is not None and (graph.shift is None or edges is graph.edges):
-        from ..native import NativeError
-        try:
-            length, zero = f(graph.pos, edges, graph.shift)
-        except NativeError:
-            pass
-        else:
-            if zero:
-                raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
-            return length
+    if graph.shift is None or edges is graph.edges:
+        from ..native import pair_lengths
+        length, zero = pair_lengths(graph.pos, edges, graph.shift)
+        if zero:
+            raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+        return length
+    return _periodic_lengths(graph, edges)
+
+
+def _periodic_lengths(graph: ContactGraph, edges) -> np.ndarray:
     d = graph.edge_vectors(edges)
     length = np.sqrt(np.einsum("ij,ij->i", d, d))
     if np.any(length <= 0):
@@ -177,7 +176,8 @@ class ConductanceLaw:
 @register_conductance_law("continuum")
 class ContinuumLaw(ConductanceLaw):
     """Paper 000 eq. 4-5: g = sqrt(S_i S_j) / l_ij on the bonds (compiled,
-    :func:`yade_electro.native.continuum_factors`, where it builds; else numpy)."""
+    :func:`yade_electro.native.continuum_factors`; a periodic graph's bonds, which cross the
+    cell, by numpy)."""
 
     name = "continuum"
 
@@ -188,18 +188,18 @@ class ContinuumLaw(ConductanceLaw):
         edges = self._edges(graph, edges)
         if edges is not graph.edges and not np.array_equal(edges, graph.edges):
             raise ValueError("the continuum law conducts through the bonds of the graph only")
-        f = native_helper("continuum_factors")
-        if f is not None and graph.shift is None:
-            from ..native import NativeError
-            try:
-                g, coincident = f(graph.pos, graph.radius, polyhedron_alpha(graph.degree) * graph.radius ** 2,
-                                  graph.edges, self.threshold, self.factor_)
-            except NativeError:
-                pass
-            else:
-                if coincident:
-                    raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
-                return g
+        if graph.shift is None:
+            from ..native import continuum_factors
+            g, coincident = continuum_factors(graph.pos, graph.radius, polyhedron_alpha(graph.degree) * graph.radius ** 2,
+                                              graph.edges, self.threshold, self.factor_)
+            if coincident:
+                raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+            return g
+        return self.periodic_factor(graph, edges)
+
+    def periodic_factor(self, graph, edges):
+        """g of the bonds of a periodic graph (numpy: the eccentricities and surfaces of
+        :mod:`yade_electro.laws.transmission`)."""
         s = edge_transmission_surface(graph, threshold=self.threshold, factor=self.factor_)
         return s / edge_lengths(graph, edges)
 
@@ -218,23 +218,22 @@ def contact_radius(graph: ContactGraph, edges=None, model: str = "geometric") ->
     (r1 + r2), delta = r1 + r2 - d; for a Hertz contact under a force F (YADE's
     Hertz-Mindlin law), a = (3 F R* / (4 E*))^(1/3).
 
-    Compiled (:func:`yade_electro.native.contact_radii`, numpy's operations in one pass)
-    where it builds, else numpy.
+    Compiled (:func:`yade_electro.native.contact_radii`); other pairs than the edges of a
+    periodic graph by numpy.
     """
     if model not in CONTACT_RADII:
         raise ValueError(f"contact radius model must be one of {CONTACT_RADII}, got {model!r}")
     edges = graph.edges if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    f = native_helper("contact_radii")
-    if f is not None and (graph.shift is None or edges is graph.edges):
-        from ..native import NativeError
-        try:
-            a, coincident = f(graph.pos, graph.radius, edges, graph.shift, model)
-        except NativeError:
-            pass
-        else:
-            if coincident:
-                raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
-            return a
+    if graph.shift is None or edges is graph.edges:
+        from ..native import contact_radii
+        a, coincident = contact_radii(graph.pos, graph.radius, edges, graph.shift, model)
+        if coincident:
+            raise MaterialError("two connected elements have coincident centres (l_ij = 0)")
+        return a
+    return _periodic_contact_radius(graph, edges, model)
+
+
+def _periodic_contact_radius(graph: ContactGraph, edges, model: str) -> np.ndarray:
     r1 = graph.radius[edges[:, 0]]
     r2 = graph.radius[edges[:, 1]]
     d = edge_lengths(graph, edges)

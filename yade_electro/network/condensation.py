@@ -32,8 +32,8 @@ def _pattern(rows, cols, shape, native: bool = False):
     pair, the index of its entry in ``data``; and whether the pairs were all distinct.
 
     ``native``: distinct pairs by the compiled helper
-    (:func:`yade_electro.native.csr_pattern`, the same pattern and slots in one call) where it
-    builds; repeated pairs, or no helper, go the ways below.
+    (:func:`yade_electro.native.csr_pattern`, the same pattern and slots in one call);
+    repeated pairs go the ways below (``native=False``, the tests' reference, goes there too).
 
     Distinct pairs (the usual case: an edge list without repeats) go through scipy's COO to
     CSR conversion, a counting sort by row and a sort within each row, both in C, carrying
@@ -44,11 +44,8 @@ def _pattern(rows, cols, shape, native: bool = False):
     rows = np.asarray(rows)
     N = rows.size
     if native and N:
-        from ..native import NativeError, csr_pattern
-        try:
-            got = csr_pattern(rows, cols, shape)
-        except NativeError:
-            got = None
+        from ..native import csr_pattern
+        got = csr_pattern(rows, cols, shape)
         if got is not None:
             indptr, indices, slot = got
             M = sp.csr_matrix((np.zeros(N), indices, indptr), shape=shape)
@@ -230,19 +227,12 @@ class ReducedSystem:
     def _fill_compiled(self, c, diagonal) -> bool:
         """K_uu's values by the compiled pass (:func:`yade_electro.native.laplacian_fill`: the
         numpy form's operations, 2-3x faster at 5,000-20,000 unknowns); False when it is not
-        asked for or cannot be built (then numpy)."""
+        asked for (``native=False``: the numpy form, the tests' reference)."""
         if not self._native:
             return False
-        from ..native import NativeError, laplacian_fill
+        from ..native import laplacian_fill
         o1, o2 = self._off
-        try:
-            laplacian_fill(self.Kuu.data, c, self._e_uu, o1, o2, self.diagonal_slots, self._incidence, diagonal)
-        except NativeError as exc:
-            import logging
-            logging.getLogger(__name__).info("the compiled Laplacian fill is not available (%s); numpy instead", exc)
-            self._native = False
-            self.compiled = False
-            return False
+        laplacian_fill(self.Kuu.data, c, self._e_uu, o1, o2, self.diagonal_slots, self._incidence, diagonal)
         self.compiled = True
         return True
 

@@ -16,7 +16,6 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..native import NativeError
 
 __all__ = ["Relaxer", "random_inside", "jam", "max_overlap", "shrink_to_remove_overlaps", "morton_order",
            "SPATIAL_ORDER_FROM"]
@@ -129,17 +128,13 @@ class Relaxer:
 
     def fire_steps(self):
         """The compiled FIRE steps (:class:`yade_electro.native.FireSteps`) in spatial mode,
-        None otherwise or when they cannot be built (numpy then)."""
+        None otherwise (numpy then)."""
         if not self.spatial or not self.native:
             return None
         if self._fire is None:
-            try:
-                from ..native import FireSteps
-                self._fire = FireSteps()
-            except NativeError as exc:
-                log.info("jamming: the compiled FIRE steps are not available (%s); numpy instead", exc)
-                self._fire = False
-        return self._fire or None
+            from ..native import FireSteps
+            self._fire = FireSteps()
+        return self._fire
 
     def _fire_ops(self):
         """The FIRE operations: compiled in spatial mode, numpy otherwise."""
@@ -176,14 +171,10 @@ class Relaxer:
     def _pair_forces(self, x, s, p):
         """Sphere-sphere forces, overlaps (in pair order) and the largest: compiled
         (:func:`yade_electro.native.soft_sphere_forces`, the same bits) unless ``native`` is
-        False or the helper cannot be built."""
+        False (the numpy form, the tests' reference)."""
         if self.native:
-            try:
-                from ..native import soft_sphere_forces
-                return soft_sphere_forces(x, self.rho, s, p)
-            except NativeError as exc:
-                log.info("jamming: the compiled pair forces are not available (%s); numpy instead", exc)
-                self.native = False
+            from ..native import soft_sphere_forces
+            return soft_sphere_forces(x, self.rho, s, p)
         return pair_forces_numpy(x, self.rho, s, p)
 
     def forces(self, x, s):

@@ -144,21 +144,17 @@ class DeflatedCGSolver(CGSolver):
         self._coarse_values()
 
     def _compiled(self, A, n, k, rows):
-        """The compiled iterations for this setup, or None (numpy): not asked for, indices
-        that do not fit int32, or no compiler. ``rows``: the row of each non-zero of A."""
+        """The compiled iterations for this setup, or None (numpy): not asked for
+        (``native=False``), or indices that do not fit int32. ``rows``: the row of each
+        non-zero of A."""
         if not self.native or A.indices.dtype != np.int32 or A.indptr.dtype != np.int32:
             return None
         # where each row's diagonal sits in A.data (the compiled refill reads it there)
         diag_pos = np.flatnonzero(A.indices == rows)
         if diag_pos.size != n or not np.array_equal(rows[diag_pos], np.arange(n)):
             return None
-        from ..native import DeflatedCG, NativeError
-        try:
-            dcg = DeflatedCG(n, k)
-        except NativeError as exc:
-            log.info("cg-deflated: the compiled iterations are not available (%s); numpy instead", exc)
-            self.native = False
-            return None
+        from ..native import DeflatedCG
+        dcg = DeflatedCG(n, k)
         dcg.coarse_pattern(self._e_key)
         self._diag_pos = diag_pos.astype(np.int64)
         return dcg
