@@ -29,6 +29,14 @@ CASES = {
     "notched_voronoi": ("cases/notched_joule.py", ["--n", "5000", "--law", "voronoi"]),
     "cross_engine_heat": ("cases/cross_engine_heat.py", []),
 }
+#: the long cases (5-16 min each), run by name with --only
+LONG_CASES = {
+    "pin_torsion": ("cases/pin_torsion.py", []),
+    "container_heating": ("cases/container_heating.py", []),
+    "falling_bed": ("cases/falling_bed.py", []),
+    "rotating_drum": ("cases/rotating_drum.py", []),
+    "cross_engine_packing": ("cases/cross_engine_packing.py", []),
+}
 #: keys left out of the comparison: times, and paths of written files
 SKIPPED_PREFIXES = ("t_", "time_s", "wall_s", "png", "csv", "vtk", "out")
 
@@ -89,12 +97,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("old")
     ap.add_argument("new")
-    ap.add_argument("--only", default=None, help="comma-separated case names (default: all)")
+    ap.add_argument("--only", default=None, help="comma-separated case names (default: all but the long ones)")
     ap.add_argument("--out", default="out/compare_trees")
     args = ap.parse_args(argv)
     names = args.only.split(",") if args.only else list(CASES)
     for name in names:
-        script, cargs = CASES[name]
+        script, cargs = {**CASES, **LONG_CASES}[name]
         a = run(os.path.abspath(args.old), script, cargs, os.path.join(args.out, name, "old"))
         b = run(os.path.abspath(args.new), script, cargs, os.path.join(args.out, name, "new"))
         print(json.dumps({"case": name, **compare(a, b)}), flush=True)
