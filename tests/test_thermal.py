@@ -548,3 +548,18 @@ def test_coupled_time_step_figures():
     assert ts["paper"] == pytest.approx(diffusion_time_step(g, LAMBDA, DENSITY, SPECIFIC_HEAT))
     # the lumped bound is the same order as the paper's figure on a regular lattice
     assert 0.1 < ts["critical"] / ts["paper"] < 10
+
+
+def test_the_resistivity_is_held_in_one_place():
+    """rho_0 is the electrical model's: the coupled model reads it there, a change reaches both,
+    and a heat material that says otherwise is refused."""
+    el = electrical(potential=1e-3)
+    heat = Material(density=DENSITY, specific_heat=SPECIFIC_HEAT, conductivity=LAMBDA)
+    m = ElectroThermalModel(el, heat, 293.15)
+    assert m.material.resistivity == el.material.resistivity == RHO_E
+    m.set_material(resistivity=2 * RHO_E, conductivity=2 * LAMBDA)
+    assert m.material.resistivity == el.material.resistivity == el.resistivity == 2 * RHO_E
+    assert m.material.conductivity == 2 * LAMBDA and m.material.beta == 0.0
+    with pytest.raises(MaterialError, match="the resistivity belongs to the electrical model"):
+        ElectroThermalModel(el, Material(resistivity=3 * RHO_E, density=DENSITY, specific_heat=SPECIFIC_HEAT,
+                                         conductivity=LAMBDA), 293.15)

@@ -131,7 +131,8 @@ class ElectroThermalModel:
                 raise MaterialError(f"the heat model needs Material(density=..., specific_heat=..., conductivity=...) "
                                     f"(kg/m^3, J/(kg K), W/(m K)); {name} is missing")
         T0 = self.initial_temperature if material.reference_temperature is None else material.reference_temperature
-        self.material = dataclasses.replace(material, resistivity=rho0, reference_temperature=T0)
+        self._heat_material = dataclasses.replace(material, resistivity=None, reference_temperature=T0)
+        self._material = None
         self.T0 = float(self.material.reference_temperature)
         self.beta = self.material.beta
         law = Law.of(law)
@@ -389,11 +390,26 @@ class ElectroThermalModel:
             raise ValueError(f"set_material: unknown properties {sorted(unknown)}")
         if "resistivity" in properties and self.electrical is None:
             raise MaterialError("a heat-only model has no resistivity")
-        self.material = dataclasses.replace(self.material, **properties)
-        if "resistivity" in properties:
-            self.electrical.set_resistivity(self.material.resistivity)
+        rho0 = properties.pop("resistivity", None)
+        if properties:
+            self._heat_material = dataclasses.replace(self._heat_material, **properties)
+        if rho0 is not None:
+            self.electrical.set_material(resistivity=rho0)
             self._rho_solved = None
+        self._material = None
         self._materials_changed = True
+
+    @property
+    def material(self) -> Material:
+        """The material: density, specific heat, conductivity, beta and T_0 held here, rho_0
+        the electrical model's (the one place it is kept)."""
+        if self.electrical is None:
+            return self._heat_material
+        m = self._material
+        if m is None or m[0] is not self.electrical.material:
+            m = self._material = (self.electrical.material, dataclasses.replace(
+                self._heat_material, resistivity=self.electrical.material.resistivity))
+        return m[1]
 
     def set_temperatures(self, nodes, temperatures):
         """Set the temperatures [K] of ``nodes`` of the current graph now (e.g. particles just

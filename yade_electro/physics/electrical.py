@@ -20,6 +20,7 @@ Units: SI (ohm m, V, A, ohm, W, s).
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 from typing import Dict, List, Mapping, Optional, Sequence
@@ -200,9 +201,16 @@ class ElectricalModel:
         self.values[name] = electrode_value(name, value)
 
     def set_resistivity(self, resistivity):
-        """Change rho_e [ohm m] (scalar or per node); a value update at the next solve."""
+        """The resistivity in use, rho_e [ohm m] (scalar or per node), e.g. rho_e(T) of a
+        coupled model; a value update at the next solve. The material's rho_0 stays."""
         self.resistivity = positive_property("resistivity", resistivity, None, " (ohm m)")
         self._rho_stale = True
+
+    def set_material(self, resistivity):
+        """A new rho_0 [ohm m] (scalar or per node): the material's, held here only (a coupled
+        model reads it from here), and the resistivity in use."""
+        self.material = dataclasses.replace(self.material, resistivity=resistivity)
+        self.set_resistivity(self.material.resistivity)
 
     def reset(self):
         """Forget everything derived from earlier graphs (network, solver setup); the electrode

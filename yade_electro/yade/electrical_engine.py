@@ -216,7 +216,7 @@ class ElectricalEngine(EngineBase):
         return {"resistivity": self._resistivity}
 
     def _set_properties(self, props):
-        self.model.set_resistivity(props["resistivity"])
+        self.model.set_material(resistivity=props["resistivity"])
 
     def _feed_electrode_walls(self):
         if self.model is None:
