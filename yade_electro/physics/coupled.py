@@ -122,8 +122,8 @@ class ElectroThermalModel:
         rho0 = electrical.material.resistivity if electrical is not None else None
         if material.resistivity is not None and (rho0 is None or not np.array_equal(
                 np.asarray(material.resistivity), np.asarray(rho0))):
-            raise MaterialError("the resistivity belongs to the electrical model (ElectricalModel(resistivity=...)); "
-                                "leave it out of the heat model's material")
+            raise MaterialError("the resistivity belongs to the electrical model (ElectricalModel(Material("
+                                "resistivity=...), ...)); leave it out of the heat model's material")
         if material.beta != 0.0 and electrical is None:
             raise MaterialError("beta (rho_e(T)) needs an electrical model")
         for name in ("density", "specific_heat", "conductivity"):
