@@ -45,10 +45,10 @@ from ..core.history import History
 from ..core.materials import Material, real_number, thermal_conductance_of
 from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
-from ..network.boundary import Condition, FixedValue
-from ..network.heat_conditions import ThermalWall
+from ..network.boundary import FixedValue
 from ..network.transient import HeatSolver
-from .thermal import diffusion_time_step, heat_capacity, source_power, surface_conditions
+from .thermal import (diffusion_time_step, heat_capacity, heat_material, source_power, split_heat_boundaries,
+                      surface_conditions)
 
 from .walls import WallContacts
 
@@ -119,19 +119,8 @@ class ElectroThermalModel:
                             f"(yade_electro.core.materials), got {material!r}")
         self.electrical = electrical
         self.initial_temperature = real_number("temperature (K)", temperature)
-        rho0 = electrical.material.resistivity if electrical is not None else None
-        if material.resistivity is not None and (rho0 is None or not np.array_equal(
-                np.asarray(material.resistivity), np.asarray(rho0))):
-            raise MaterialError("the resistivity belongs to the electrical model (ElectricalModel(Material("
-                                "resistivity=...), ...)); leave it out of the heat model's material")
-        if material.beta != 0.0 and electrical is None:
-            raise MaterialError("beta (rho_e(T)) needs an electrical model")
-        for name in ("density", "specific_heat", "conductivity"):
-            if getattr(material, name) is None:
-                raise MaterialError(f"the heat model needs Material(density=..., specific_heat=..., conductivity=...) "
-                                    f"(kg/m^3, J/(kg K), W/(m K)); {name} is missing")
-        T0 = self.initial_temperature if material.reference_temperature is None else material.reference_temperature
-        self._heat_material = dataclasses.replace(material, resistivity=None, reference_temperature=T0)
+        self._heat_material = heat_material(material, electrical.material if electrical is not None else None,
+                                            self.initial_temperature)
         self._material = None
         self.T0 = float(self.material.reference_temperature)
         self.beta = self.material.beta
@@ -147,21 +136,7 @@ class ElectroThermalModel:
         self.eta = float(integrator.eta)
         self.heat_options = dict(theta=integrator.theta, subcycle=integrator.subcycle, safety=integrator.safety,
                                  max_substeps=integrator.max_substeps, solver=integrator.solver)
-        self.conditions, self.heat_sources, self.walls = [], [], []
-        for bc in boundaries:
-            if isinstance(bc, ThermalWall):
-                self.walls.append(bc)
-            elif isinstance(bc, Condition) and bc.ROLE in ("fixed", "injection", "robin"):
-                self.conditions.append(bc)
-            elif isinstance(bc, Condition) and bc.ROLE == "source":
-                self.heat_sources.append(bc)
-            else:
-                raise TypeError(f"boundaries= takes FixedTemperature, HeatFlux, Convection, HeatSource and "
-                                f"ThermalWall objects (or FixedValue, Injection, Robin, Source), got {bc!r}")
-        names = [b.name for b in self.conditions + self.heat_sources + self.walls]
-        if len(set(names)) != len(names):
-            raise BoundaryConditionError(f"thermal boundary condition, heat source and wall names must be unique, "
-                                         f"got {names}")
+        self.conditions, self.heat_sources, self.walls = split_heat_boundaries(boundaries)
         everything = self.conditions
         self.bc_memberships = {b.name: Membership(b.name, b.nodes, what=b.KIND)
                                for b in everything if b.surface is None}

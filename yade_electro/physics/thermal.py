@@ -21,20 +21,25 @@ Units: SI (kg/m^3, J/(kg K), W/(m K), W/(m^2 K), K or degC, J/K, W, s).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Optional
 
 import numpy as np
 
+from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
-from ..core.materials import positive_property, thermal_conductance_of
+from ..core.materials import Material, positive_property, thermal_conductance_of
 from ..laws.factors import make_law
 from ..laws.transmission import volume_fraction as _volume_fraction
+from ..network.boundary import Condition
+from ..network.heat_conditions import ThermalWall
 from ..network.kirchhoff import edge_power
 from ..network.transient import HeatSolver
 
 __all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
-           "electrical_power", "heat_solver_on_graph", "surface_conditions", "source_power"]
+           "electrical_power", "heat_solver_on_graph", "heat_material", "split_heat_boundaries", "surface_conditions",
+           "source_power"]
 
 
 # ---------------------------------------------------------------------------------------
@@ -153,6 +158,51 @@ def heat_solver_on_graph(graph: ContactGraph, density, specific_heat, conductivi
     G = thermal_conductance(graph, conductivity, law, **(law_params or {}))
     kw.setdefault("coords", graph.pos)
     return HeatSolver(C, graph.edges, G, temperature, graph=graph, **kw)
+
+
+# ---------------------------------------------------------------------------------------
+# the heat model's material and boundaries
+# ---------------------------------------------------------------------------------------
+def heat_material(material: Material, electrical: Optional[Material], temperature: float) -> Material:
+    """The heat model's own ``material`` checked: density, specific heat and conductivity
+    given; ``beta`` only with an electrical model; no resistivity other than the electrical
+    model's (``electrical``, the one place rho_0 is held: the result leaves it out);
+    ``reference_temperature`` defaulting to ``temperature`` [K]. MaterialError otherwise."""
+    rho0 = electrical.resistivity if electrical is not None else None
+    if material.resistivity is not None and (rho0 is None or not np.array_equal(np.asarray(material.resistivity),
+                                                                               np.asarray(rho0))):
+        raise MaterialError("the resistivity belongs to the electrical model (ElectricalModel(Material("
+                            "resistivity=...), ...)); leave it out of the heat model's material")
+    if material.beta != 0.0 and electrical is None:
+        raise MaterialError("beta (rho_e(T)) needs an electrical model")
+    for name in ("density", "specific_heat", "conductivity"):
+        if getattr(material, name) is None:
+            raise MaterialError(f"the heat model needs Material(density=..., specific_heat=..., conductivity=...) "
+                                f"(kg/m^3, J/(kg K), W/(m K)); {name} is missing")
+    T0 = temperature if material.reference_temperature is None else material.reference_temperature
+    return dataclasses.replace(material, resistivity=None, reference_temperature=T0)
+
+
+def split_heat_boundaries(boundaries) -> tuple:
+    """``(conditions, sources, walls)`` of a heat model's one list of boundaries: fixed values,
+    injections and Robin terms; sources; ``ThermalWall``s. TypeError for anything else,
+    BoundaryConditionError for a name given twice."""
+    conditions, sources, walls = [], [], []
+    for bc in boundaries:
+        if isinstance(bc, ThermalWall):
+            walls.append(bc)
+        elif isinstance(bc, Condition) and bc.ROLE in ("fixed", "injection", "robin"):
+            conditions.append(bc)
+        elif isinstance(bc, Condition) and bc.ROLE == "source":
+            sources.append(bc)
+        else:
+            raise TypeError(f"boundaries= takes FixedTemperature, HeatFlux, Convection, HeatSource and "
+                            f"ThermalWall objects (or FixedValue, Injection, Robin, Source), got {bc!r}")
+    names = [b.name for b in conditions + sources + walls]
+    if len(set(names)) != len(names):
+        raise BoundaryConditionError(f"thermal boundary condition, heat source and wall names must be unique, got "
+                                     f"{names}")
+    return conditions, sources, walls
 
 
 # ---------------------------------------------------------------------------------------
