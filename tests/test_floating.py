@@ -54,3 +54,17 @@ def test_current_follows_the_same_policy():
                                                      Electrode("b", [2], potential=0.0),
                                                      Electrode("c", [3], current=1.0)])
 
+
+
+def test_a_node_joined_only_by_edges_of_zero_conductance_floats():
+    """A contact that opened stays in the structure with conductance 0: the node it held joins
+    nothing, so a steady solve keeps its temperature (the floating policy) instead of failing
+    on a zero diagonal."""
+    C = np.array([1.0, 1.0, 1.0, 1.0])
+    hs = HeatSolver(C, [[0, 1], [1, 2], [1, 3]], [1.0, 1.0, 1.0], [300.0, 300.0, 300.0, 345.0],
+                    conditions=[FixedTemperature("cold", [0], 300.0), FixedTemperature("hot", [2], 400.0)])
+    hs.update_values(conductance=[1.0, 1.0, 0.0])          # node 3's only contact (to node 1) opened
+    with pytest.warns(UserWarning, match=r"1 element\(s\) in 1 part\(s\)"):
+        st = hs.steady()
+    assert st.temperature[3] == 345.0 and st.floating.tolist() == [False, False, False, True]
+    assert st.temperature[1] == pytest.approx(350.0, rel=1e-12)

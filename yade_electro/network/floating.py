@@ -56,7 +56,9 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
     Parameters
     ----------
     matrix : (m, m) sparse
-        The unknowns' block of the network matrix (its pattern gives the connected parts).
+        The unknowns' block of the network matrix: its non-zero entries give the connected
+        parts (an edge kept in the structure with conductance 0, a contact that opened, joins
+        nothing).
     anchored : (m,) bool
         Unknowns tied to a fixed value (a link, a convection, a fixed neighbour).
     inflow : (m,) float
@@ -75,7 +77,10 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
     """
     if matrix.shape[0] == 0:
         return None
-    n_parts, labels = connected_components(matrix, directed=False)
+    conducting = matrix.copy()
+    conducting.data = (conducting.data != 0).astype(np.int8)
+    conducting.eliminate_zeros()                 # csgraph takes stored zeros for edges
+    n_parts, labels = connected_components(conducting, directed=False)
     anchor = np.zeros(n_parts, bool)
     np.logical_or.at(anchor, labels, np.asarray(anchored, bool))
     if np.all(anchor):
