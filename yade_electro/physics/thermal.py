@@ -185,7 +185,7 @@ def heat_material(material: Material, electrical: Optional[Material], temperatur
 
 def split_heat_boundaries(boundaries) -> tuple:
     """``(conditions, sources, walls)`` of a heat model's one list of boundaries: fixed values,
-    injections and Robin terms; sources; ``ThermalWall``s. TypeError for anything else,
+    injections and Robin terms; sources; the ``ThermalWall`` objects. TypeError for anything else,
     BoundaryConditionError for a name given twice."""
     conditions, sources, walls = [], [], []
     for bc in boundaries:
