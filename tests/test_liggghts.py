@@ -221,3 +221,30 @@ def test_bad_heat_deck_inputs_are_refused():
         L.heat_conduction_deck(d, [COPPER], 300.0, 1e-5, 10, 5, initial_temperature={7: 400.0})
     with pytest.raises(ValueError, match="area_correction needs young_original"):
         L.heat_conduction_deck(d, [COPPER], 300.0, 1e-5, 10, 5, area_correction=True)
+
+
+def test_heat_deck_under_mpi_gives_the_same_temperatures(liggghts_exe, tmp_path):
+    """The heat deck run by 2 MPI processes (``mpiexec -n 2 liggghts``, a 2 x 1 x 1 processor
+    grid: each rank owns half the spheres and sees the other half's edge as ghosts) gives the
+    same temperatures as one process, to the dump's precision: the cross-checks can run
+    decomposed."""
+    import shutil
+    if shutil.which("mpiexec") is None and shutil.which("mpirun") is None:
+        pytest.skip("no mpiexec")
+    r = 1e-3
+    pts = np.array([[2 * i * 0.98 * r, 2 * j * 0.98 * r, (1 + 2 * k) * 0.98 * r]
+                    for i in range(10) for j in range(4) for k in range(3)]) - [9e-3, 3e-3, 0.0]
+    box = [[-0.012, 0.012], [-0.006, 0.006], [-0.002, 0.01]]
+    d = L.particle_data(pts, r, 8900.0, box=box)
+    mat = L.GranularMaterial(young=1e8, poisson=0.3, density=8900.0, conductivity=385.0, specific_heat=172.0)
+    tables, runs = {}, {}
+    for ranks in (1, 2):
+        deck = L.heat_conduction_deck(d, [mat], 273.15, 1e-6, 4000, 1000,
+                                      walls=[L.PlaneWall("z", 0.0, temperature=373.15)])
+        res = L.run_heat_conduction(deck, tmp_path / f"np{ranks}", exe=liggghts_exe, progress=None, ranks=ranks)
+        tables[ranks], runs[ranks] = res.temperature_table(), res.run
+    assert "2 by 1 by 1 MPI processor grid" in runs[2].text()
+    assert (tables[1].to_numpy() - 273.15).max() > 10.0              # the floor heats the bed
+    np.testing.assert_array_equal(tables[2].to_numpy(), tables[1].to_numpy())
+    with pytest.raises(ValueError, match="ranks must be a whole number >= 1"):
+        L.run_heat_conduction(deck, tmp_path / "bad", exe=liggghts_exe, progress=None, ranks=0)

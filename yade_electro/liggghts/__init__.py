@@ -10,7 +10,7 @@ from .deck import (TEMPLATE_DIR, CylinderWall, GranularMaterial, MeshWall, Plane
 from .dumps import DumpFrame, read_dump, read_dump_frames
 from .settling import BlockRegion, CylinderRegion, SettledPacking, settle_deck, settle_packing
 from .heat import HEAT_PAIR_KEYWORDS, HeatDeck, HeatRunResult, heat_conduction_deck, run_heat_conduction
-from .runner import LiggghtsError, LiggghtsNotFound, LiggghtsRun, find_liggghts, run_deck
+from .runner import LiggghtsError, LiggghtsNotFound, LiggghtsRun, find_liggghts, mpi_command, run_deck
 
 __all__ = [
     "ParticleData", "particle_data", "format_data", "write_data", "read_data",
@@ -18,6 +18,6 @@ __all__ = [
     "material_commands", "wall_commands", "temperature_commands", "size_class_commands", "pair_local_columns",
     "DumpFrame", "read_dump", "read_dump_frames",
     "HEAT_PAIR_KEYWORDS", "HeatDeck", "HeatRunResult", "heat_conduction_deck", "run_heat_conduction",
-    "LiggghtsError", "LiggghtsNotFound", "LiggghtsRun", "find_liggghts", "run_deck",
+    "LiggghtsError", "LiggghtsNotFound", "LiggghtsRun", "find_liggghts", "mpi_command", "run_deck",
     "CylinderRegion", "BlockRegion", "SettledPacking", "settle_deck", "settle_packing",
 ]

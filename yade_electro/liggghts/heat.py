@@ -135,10 +135,11 @@ class HeatRunResult:
 
 
 def run_heat_conduction(deck: HeatDeck, workdir, exe=None, timeout: float = 600.0,
-                        progress: Optional[float] = 10.0) -> HeatRunResult:
-    """Run a :class:`HeatDeck` in ``workdir`` and read its dumps."""
+                        progress: Optional[float] = 10.0, ranks: int = 1) -> HeatRunResult:
+    """Run a :class:`HeatDeck` in ``workdir`` and read its dumps; ``ranks`` MPI processes
+    (see :func:`~yade_electro.liggghts.runner.run_deck`)."""
     run = run_deck(deck.deck, workdir, files=deck.files, exe=exe, timeout=timeout, progress=progress,
-                   total_steps=deck.steps)
+                   total_steps=deck.steps, ranks=ranks)
     atoms = read_dump(Path(workdir) / deck.atom_dump,
                       columns=["id", "type", "radius", "x", "y", "z", "Temp", "heat_flux"])
     contacts = read_dump(Path(workdir) / deck.pair_dump, columns=pair_local_columns(HEAT_PAIR_KEYWORDS))

@@ -20,7 +20,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
-__all__ = ["LiggghtsError", "LiggghtsNotFound", "LiggghtsRun", "find_liggghts", "run_deck"]
+import numpy as np
+
+__all__ = ["LiggghtsError", "LiggghtsNotFound", "LiggghtsRun", "find_liggghts", "mpi_command", "run_deck"]
 
 INSTALL_HINT = "install it with `apt-get install liggghts` (Debian 12), or pass exe= the path of a LIGGGHTS binary"
 
@@ -87,9 +89,25 @@ def _scan(path: Path):
     return error, warnings, thermo
 
 
+def mpi_command(ranks: int) -> list:
+    """The launcher of ``ranks`` MPI processes: ``mpiexec -n ranks`` (Open MPI's
+    ``--oversubscribe``, so that more ranks than cores run, and ``--allow-run-as-root`` when
+    run as root, as in a container); ValueError for ranks < 1, LiggghtsNotFound without
+    ``mpiexec``."""
+    if not isinstance(ranks, (int, np.integer)) or isinstance(ranks, bool) or ranks < 1:
+        raise ValueError(f"ranks must be a whole number >= 1, got {ranks!r}")
+    launcher = shutil.which("mpiexec") or shutil.which("mpirun")
+    if launcher is None:
+        raise LiggghtsNotFound("ranks > 1 needs mpiexec (Open MPI: `apt-get install openmpi-bin`)")
+    cmd = [launcher, "--oversubscribe"]
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        cmd.append("--allow-run-as-root")
+    return cmd + ["-n", str(int(ranks))]
+
+
 def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_name: str = "in.liggghts",
              progress: Optional[float] = 10.0, total_steps: Optional[int] = None,
-             total_is_bound: bool = False) -> LiggghtsRun:
+             total_is_bound: bool = False, ranks: int = 1) -> LiggghtsRun:
     """Write ``deck`` (the text of an input deck) and ``files`` (name -> text) into
     ``workdir`` and run LIGGGHTS on it there.
 
@@ -111,6 +129,9 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     total_steps : int, optional
         With ``progress``: the steps expected, for an estimate of the time left;
         ``total_is_bound``: they are at most (a run that may stop early, as settling does).
+    ranks : int
+        MPI processes (``mpiexec -n ranks liggghts ...``, LIGGGHTS' own domain decomposition;
+        1: a plain run). The dumps are gathered by LIGGGHTS into one file either way.
 
     Raises
     ------
@@ -130,6 +151,8 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     cmd = [binary, "-in", deck_path.name, "-log", log.name, "-nocite"]
     if shutil.which("stdbuf"):
         cmd = ["stdbuf", "-o0", "-e0"] + cmd
+    if ranks != 1:
+        cmd = mpi_command(ranks) + cmd
     env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
     t0 = time.perf_counter()
     last_print = t0
