@@ -3,8 +3,8 @@ injections, Robin terms, sources) with its thermal and electrical names, condens
 values, Kirchhoff networks with terminals, the theta-method integrator with sub-cycling, steady
 solves, one policy for floating parts, and the energy ledger. Never imports YADE.
 """
-from .boundary import (boundary_value, check_place, check_area, Condition, FixedValue, Terminal, Injection, Robin,
-                       Source, generic, check_condition)
+from .boundary import (boundary_value, check_place, check_area, terminal_number, Condition, TerminalRole, FixedValue,
+                       Terminal, Injection, Robin, Source, generic, check_condition)
 from .condensation import ReducedSystem
 from .heat_conditions import FixedTemperature, ThermalWall, HeatFlux, Convection, HeatSource
 from .resolution import resolve_nodes, resolve_area, ResolvedConditions, resolve_conditions
@@ -18,8 +18,8 @@ from .structure import Words, GENERIC_WORDS, NetworkStructure
 from .theta import theta_of, stable_time_step, THETA_NAMES
 from .transient import HeatSolver
 
-__all__ = ["boundary_value", "check_place", "check_area", "Condition", "FixedValue", "Terminal", "Injection",
-           "Robin", "Source", "generic", "check_condition", "ReducedSystem", "FixedTemperature", "ThermalWall",
+__all__ = ["boundary_value", "check_place", "check_area", "terminal_number", "Condition", "TerminalRole", "FixedValue",
+           "Terminal", "Injection", "Robin", "Source", "generic", "check_condition", "ReducedSystem", "FixedTemperature", "ThermalWall",
            "HeatFlux", "Convection", "HeatSource", "resolve_nodes", "resolve_area", "ResolvedConditions",
            "resolve_conditions", "ConductionProblem", "solve_potential", "equivalent_resistance",
            "floating_message", "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",

@@ -41,8 +41,8 @@ from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.materials import real_number
 from ..core.selection import check_selector
 
-__all__ = ["boundary_value", "check_place", "check_area", "Condition", "FixedValue", "Terminal", "Injection",
-           "Robin", "Source", "generic", "check_condition"]
+__all__ = ["boundary_value", "check_place", "check_area", "terminal_number", "Condition", "TerminalRole",
+           "FixedValue", "Terminal", "Injection", "Robin", "Source", "generic", "check_condition"]
 
 
 def boundary_value(name, v) -> float:
@@ -180,12 +180,19 @@ def _check_terminal(c: Condition) -> None:
                                      f"{', ' + c._unit('value') if c._unit('value') else ''}) or {r}= (imposed {r}"
                                      f"{', ' + c._unit('rate') if c._unit('rate') else ''})")
     role = "value" if c.field("value") is not None else "rate"
+    c._store(role, terminal_number(type(c), c.name, c.field(role)))
+
+
+def terminal_number(cls, name: str, v) -> float:
+    """A terminal's fixed value or imposed rate ``v`` as a finite float, in the words of the
+    terminal class ``cls`` (``KIND``, ``UNITS``); BoundaryConditionError otherwise. The check
+    of a terminal's number, also when a value is changed later."""
+    units = getattr(cls, "UNITS", {})
     try:
-        v = real_number(f"{c.KIND} {c.name!r}: value", c.field(role),
-                        what=f"a real number ({c._unit('value') or 'value'} or {c._unit('rate') or 'rate'})")
+        return real_number(f"{cls.KIND} {name!r}: value", v,
+                           what=f"a real number ({units.get('value') or 'value'} or {units.get('rate') or 'rate'})")
     except MaterialError as exc:
         raise BoundaryConditionError(str(exc)) from None
-    c._store(role, v)
 
 
 def _check_injection(c: Condition) -> None:
@@ -249,8 +256,24 @@ class FixedValue(Condition):
     surface: Any = None
 
 
+class TerminalRole(Condition):
+    """What every terminal answers, whatever it calls its numbers: fixed or fed, and how much."""
+
+    ROLE: ClassVar[str] = "terminal"
+
+    @property
+    def fixed(self) -> bool:
+        """True for a fixed value, False for an imposed rate."""
+        return self.field("value") is not None
+
+    @property
+    def amount(self) -> float:
+        """The fixed value or the imposed rate."""
+        return float(self.field("value") if self.fixed else self.field("rate"))
+
+
 @dataclass(frozen=True)
-class Terminal(Condition):
+class Terminal(TerminalRole):
     """Nodes tied by a perfect conductor (one value for all), at a fixed ``value`` or fed a
     total ``rate`` (its value is then an unknown). Give exactly one.
 
@@ -265,7 +288,6 @@ class Terminal(Condition):
         The total rate fed into the network (A, W, ...).
     """
 
-    ROLE: ClassVar[str] = "terminal"
     KIND: ClassVar[str] = "terminal"
     FIELDS: ClassVar[Dict[str, str]] = {"value": "value", "rate": "rate"}
 
@@ -273,16 +295,6 @@ class Terminal(Condition):
     nodes: Any = None
     value: Optional[float] = None
     rate: Optional[float] = None
-
-    @property
-    def fixed(self) -> bool:
-        """True for a fixed value, False for an imposed rate."""
-        return self.field("value") is not None
-
-    @property
-    def amount(self) -> float:
-        """The fixed value or the imposed rate."""
-        return float(self.field("value") if self.fixed else self.field("rate"))
 
 
 @dataclass(frozen=True)

@@ -11,9 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ..core.errors import BoundaryConditionError, MaterialError
-from ..core.materials import real_number
-from .boundary import Condition, check_condition
+from .boundary import TerminalRole, check_condition, terminal_number
 
 __all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "PotentialOrCurrent",
            "Electrode"]
@@ -51,11 +49,9 @@ def network_components(n_nodes: int, edges, conducting=None) -> tuple:
 
 
 def electrode_value(name: str, value) -> float:
-    """An electrode potential [V] or current [A] as a finite float, or BoundaryConditionError."""
-    try:
-        return real_number(f"electrode {name!r}: value", value, what="a real number (V or A)")
-    except MaterialError as exc:
-        raise BoundaryConditionError(str(exc)) from None
+    """An electrode potential [V] or current [A] as a finite float, or BoundaryConditionError
+    (the terminal's check, in electrical words)."""
+    return terminal_number(PotentialOrCurrent, name, value)
 
 
 def edge_power(branch_current, conductance) -> np.ndarray:
@@ -66,13 +62,12 @@ def edge_power(branch_current, conductance) -> np.ndarray:
     return np.divide(w * w, c, out=np.zeros_like(c), where=c > 0)
 
 
-class PotentialOrCurrent(Condition):
+class PotentialOrCurrent(TerminalRole):
     """What an electrode imposes, the same for every kind of electrode: a fixed ``potential``
     [V] or an imposed ``current`` [A] fed into the network, exactly one, a finite real number.
     The electrical name of a :class:`~yade_electro.network.boundary.Terminal`: checked by the
     terminal's one check (:meth:`check_value`, from the subclass's ``__post_init__``)."""
 
-    ROLE: ClassVar[str] = "terminal"
     KIND: ClassVar[str] = "electrode"
     FIELDS: ClassVar[Dict[str, str]] = {"value": "potential", "rate": "current"}
     UNITS: ClassVar[Dict[str, str]] = {"value": "V", "rate": "A"}
@@ -81,19 +76,9 @@ class PotentialOrCurrent(Condition):
         check_condition(self)
 
     @property
-    def fixed(self) -> bool:
-        """True for a fixed potential, False for an imposed current."""
-        return self.potential is not None
-
-    @property
     def value(self) -> float:
-        """The potential [V] or the current [A]."""
-        return float(self.potential if self.fixed else self.current)
-
-    @property
-    def amount(self) -> float:
-        """The potential [V] or the current [A] (the terminal's name for :attr:`value`)."""
-        return self.value
+        """The potential [V] or the current [A] (the terminal's :attr:`amount`)."""
+        return self.amount
 
 
 @dataclass(frozen=True)
