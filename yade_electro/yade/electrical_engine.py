@@ -162,10 +162,16 @@ class ElectricalEngine(EngineBase):
                                        surface=e.surface, wall=e.wall is not None, potential=e.potential,
                                        current=e.current))
         self._resistivity = resistivity
+        return ElectricalModel(resistivity, specs, law=self._law_option(law, law_params), solver=solver,
+                               measure=measure, reselect=reselect)
+
+    def _law_option(self, law: str, law_params, volume_fraction=None) -> Law:
+        """The engine's law name and parameters as a :class:`Law`, bounded by the parameters'
+        container or else the engine's."""
         params = dict(law_params or {})
-        law_container = params.pop("container", None)
-        law = Law(law, container=self.container if law_container is None else law_container, **params)
-        return ElectricalModel(resistivity, specs, law=law, solver=solver, measure=measure, reselect=reselect)
+        container = params.pop("container", None)
+        return Law(law, container=self.container if container is None else container,
+                   volume_fraction=volume_fraction, **params)
 
     # -- persistence ---------------------------------------------------------------------------
     def _electrode_config(self) -> list:

@@ -14,7 +14,6 @@ from ..physics.coupled import ElectroThermalModel
 from ..core.errors import BoundaryConditionError, ThermalError
 from ..core.materials import Material, real_number
 from ..laws.law import Law
-from ..network.boundary import Condition
 from ..network.heat_conditions import ThermalWall
 from . import persistence
 from . import registry
@@ -24,7 +23,7 @@ from .scene import TemperatureWriter, write_body_attribute
 
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
-from .options import HEAT_ROLES, Output, Reader, thermal_settings
+from .options import Output, Reader, thermal_settings
 from ..physics.integrator import MODEL_OPTIONS, Integrator
 from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
@@ -164,13 +163,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         if not time_scale > 0:
             raise ValueError(f"time_scale must be > 0, got {time_scale}")
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
-        conditions = []
-        for bc in heat_conditions:
-            if not isinstance(bc, Condition) or bc.ROLE not in HEAT_ROLES:
-                raise TypeError(f"expected heat conditions (FixedTemperature, HeatFlux, Convection, HeatSource), got "
-                                f"{bc!r}")
-            conditions.append(bc if bc.nodes is None else dataclasses.replace(
-                bc, nodes=self._normalise_selector(bc.nodes)))
+        # selectors made picklable; the model checks what each condition is (split_heat_boundaries)
+        conditions = [bc if getattr(bc, "nodes", None) is None else dataclasses.replace(
+            bc, nodes=self._normalise_selector(bc.nodes)) for bc in heat_conditions]
         if not isinstance(steady, bool):
             raise ValueError(f"steady must be True or False, got {steady!r}")
         self.steady = steady
@@ -187,8 +182,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         heat_material = Material(density=density, specific_heat=specific_heat, conductivity=conductivity,
                                  beta=beta, reference_temperature=extra.pop("reference_temperature", None))
         if self.model is None:        # the heat-only model's own law
-            params = {k: v for k, v in (self._law_params or {}).items() if k != "container"}
-            heat_law = Law(law or "continuum", container=self.container, volume_fraction=volume_fraction, **params)
+            heat_law = self._law_option(law or "continuum", self._law_params, volume_fraction)
         else:
             heat_law = Law(container=self.container, volume_fraction=volume_fraction)
         self._coupled = ElectroThermalModel(self.model, heat_material, temperature, integrator=integrator,
