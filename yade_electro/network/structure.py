@@ -99,14 +99,10 @@ class NetworkStructure:
         """The linear solver (kept while the structure is)."""
         return self._solver
 
-    def _subset_slots(self, edges):
-        """The kept edges' positions of ``edges`` when they are a subset of the kept ones (a
-        value update: the missing edges get conductance 0), else None (a new structure)."""
-        return edge_slots(self.edges, edges, self.n)
-
     def _on_subset(self, edges, conductance):
-        """The full conductance array for a subset ``edges`` of the kept edges, or None."""
-        slots = self._subset_slots(edges)
+        """The full conductance array when ``edges`` are a subset of the kept edges (a value
+        update: the missing edges get conductance 0), else None (a new structure)."""
+        slots = edge_slots(self.edges, edges, self.n)
         if slots is None:
             return None
         full = np.zeros(self.edges.shape[0])
