@@ -1,0 +1,104 @@
+"""Run under ``mpiexec -n P python3 tests/mpi_partition_check.py``: a jittered lattice rod split
+in z slabs between the ranks, solved by the partitioned solves and, whole, by the serial ones on
+every rank (the test's reference only: the library's partitioned code sees only each rank's
+share). Rank 0 prints one JSON line of the largest differences."""
+import json
+import os
+import sys
+import warnings
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from lattice import cubic_lattice  # noqa: E402
+
+from yade_electro.network.conduction import ConductionProblem  # noqa: E402
+from yade_electro.network.distributed import PartitionedConduction, PartitionedHeat  # noqa: E402
+from yade_electro.network.heat_conditions import Convection, FixedTemperature  # noqa: E402
+from yade_electro.network.kirchhoff import Electrode  # noqa: E402
+from yade_electro.network.partition import split_network  # noqa: E402
+from yade_electro.network.transient import HeatSolver  # noqa: E402
+from yade_electro.solvers.partitioned import mpi_comm  # noqa: E402
+
+comm = mpi_comm()
+rank, size = comm.Get_rank(), comm.Get_size()
+shape = (6, 5, 40)
+g = cubic_lattice(shape, r=1e-4)
+rng = np.random.default_rng(3)
+c = rng.uniform(0.5, 2.0, g.n_edges)
+layer = shape[0] * shape[1]
+n = g.n_nodes
+bottom, top = np.arange(layer), np.arange(n - layer, n)
+# a floating block: cut the edges of the last 2 nodes of layer 20 from everything
+k = lattice_k = np.arange(n) // layer
+float_nodes = np.array([20 * layer + 3, 20 * layer + 4])
+cut = np.isin(g.edges[:, 0], float_nodes) ^ np.isin(g.edges[:, 1], float_nodes)
+c[cut] = 0.0
+keep = ~cut
+edges, c = g.edges[keep], c[keep]
+# owners: z slabs, with ranks' order scrambled (owner of a slab is not its index)
+slab = np.minimum(k * size // shape[2], size - 1)
+owner = (slab * 7 + 1) % size if size > 1 else slab
+out = {"ranks": size}
+
+# -- conduction -------------------------------------------------------------------------
+with warnings.catch_warnings(record=True) as w_ser:
+    warnings.simplefilter("always")
+    serial = ConductionProblem(n, edges, c, [Electrode("a", bottom, potential=1.0), Electrode("b", top, potential=0.0)],
+                               solver="direct")
+    sol = serial.solve()
+share, held = split_network(n, edges, owner, rank)
+own = np.flatnonzero(owner == rank)
+el = np.full(own.shape[0], -1)
+el[np.isin(own, bottom)] = 0
+el[np.isin(own, top)] = 1
+for pc in ("deflation", "hypre", "gamg"):
+    with warnings.catch_warnings(record=True) as w_par:
+        warnings.simplefilter("always")
+        pcnd = PartitionedConduction(share, c[held], el, ["a", "b"], {"a": 1.0, "b": 0.0}, comm=comm,
+                                     preconditioner=pc, rtol=1e-12, pos=g.pos[own], spacing=2e-4)
+        phi = pcnd.solve()
+    d_phi = max(comm.allgather(float(np.max(np.abs(phi[:share.n_owned] - sol.potential[own]), initial=0.0))))
+    R = pcnd.equivalent_resistance()
+    I = pcnd.electrode_currents()
+    P = pcnd.joule_power()
+    from yade_electro.network.kirchhoff import edge_power
+    p_edge = edge_power(sol.branch_current, c)
+    P_ser = 0.5 * (np.bincount(edges[:, 0], p_edge, n) + np.bincount(edges[:, 1], p_edge, n))
+    d_P = max(comm.allgather(float(np.max(np.abs(P - P_ser[own]), initial=0.0))))
+    out[pc] = {"max_dphi_V": d_phi, "R_rel_diff": abs(R - sol.equivalent_resistance("a", "b")) /
+               sol.equivalent_resistance("a", "b"),
+               "I_a_rel_diff": abs(I["a"] - sol.electrode_current["a"]) / abs(sol.electrode_current["a"]),
+               "I_sum": I["a"] + I["b"], "max_dP_rel": d_P / float(np.max(P_ser)),
+               "iterations": pcnd.info["iterations"],
+               "floating_warned": [str(x.message) for x in w_par][:1] if rank == 0 else None,
+               "floating_ok": bool(np.all(phi[:share.n_owned][np.isin(own, float_nodes)] == 0.0))}
+out["serial_floating_warned"] = [str(x.message) for x in w_ser][:1]
+
+# -- heat -----------------------------------------------------------------------------------
+C = rng.uniform(1e-3, 2e-3, n)
+G = c * 1e-2
+hA = np.zeros(n)
+side = np.flatnonzero(lattice_k == 10)
+hA[side] = 3e-3
+T0 = 300.0 + rng.uniform(0, 5, n)
+Pw = rng.uniform(0, 1e-2, n)
+for theta in (0.0, 0.5, 1.0):
+    ser = HeatSolver(C, edges, G, T0, theta=theta, solver="direct",
+                     conditions=[FixedTemperature("cold", nodes=bottom, temperature=290.0),
+                                 Convection("side", nodes=side, h=1.0, t_inf=280.0, area=3e-3)])
+    fixed = np.full(n, np.nan)
+    fixed[bottom] = 290.0
+    par = PartitionedHeat(share, C[own], G[held], T0[own], fixed=fixed[own], h_area=hA[own],
+                          t_inf=np.full(own.shape[0], 280.0), theta=theta, comm=comm, rtol=1e-13,
+                          pos=g.pos[own], spacing=2e-4)
+    dt = 0.5 * par.stable_time_step() if theta == 0.0 else 0.05
+    for _ in range(5):
+        ser.advance(dt, sources=Pw)
+        par.advance(dt, power=Pw[own])
+    dT = max(comm.allgather(float(np.max(np.abs(par.T - ser.temperature[own]), initial=0.0))))
+    out[f"heat_theta_{theta:g}"] = {"max_dT_K": dT, "dt_s": dt,
+                                   "content_rel_diff": abs(par.heat_content(300.0) - float(C @ (ser.temperature - 300.0)))
+                                   / abs(float(C @ (ser.temperature - 300.0)))}
+if rank == 0:
+    print(json.dumps(out), flush=True)

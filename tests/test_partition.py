@@ -1,0 +1,93 @@
+"""The partitioned network: each rank's rows (numpy, one process) and the collective solves
+under a real ``mpiexec`` with 1, 2 and 3 ranks against the serial solvers."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from lattice import cubic_lattice
+from yade_electro.core.errors import GraphError
+from yade_electro.network.partition import LocalNetwork, OwnedRows, split_network
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def _serial_reduced(n, edges, c, fixed, value, diag):
+    L = sp.coo_matrix((np.r_[c, c, -c, -c], (np.r_[edges[:, 0], edges[:, 1], edges[:, 0], edges[:, 1]],
+                                             np.r_[edges[:, 0], edges[:, 1], edges[:, 1], edges[:, 0]])),
+                      shape=(n, n)).tocsr() + sp.diags(diag)
+    free = np.flatnonzero(~fixed)
+    return L[free][:, free].toarray(), -(L[free][:, np.flatnonzero(fixed)] @ value[fixed])
+
+
+def test_stacked_rows_of_every_rank_are_the_serial_reduced_matrix():
+    g = cubic_lattice((4, 3, 9), r=1.0)
+    n = g.n_nodes
+    rng = np.random.default_rng(0)
+    c = rng.uniform(0.5, 2.0, g.n_edges)
+    diag = rng.uniform(0, 0.1, n)
+    fixed = np.zeros(n, bool)
+    fixed[:12] = fixed[-12:] = True
+    value = np.where(np.arange(n) < 12, 1.0, 0.0)
+    owner = rng.integers(0, 3, n)                       # a scattered split, the hardest case
+    # global numbers: owned free nodes of rank 0, then rank 1, then rank 2
+    order = np.concatenate([np.flatnonzero((owner == r) & ~fixed) for r in range(3)])
+    number = np.full(n, -1)
+    number[order] = np.arange(order.shape[0])
+    A_rows, r_rows = [], []
+    for rank in range(3):
+        share, held = split_network(n, g.edges, owner, rank)
+        local_nodes = np.concatenate([np.flatnonzero(owner == rank), share.ghost_key])
+        rows = OwnedRows(share, number[local_nodes])
+        data = rows.values(c[held], diag[np.flatnonzero(owner == rank)])
+        A_rows.append(sp.csr_matrix((data, rows.indices, rows.indptr), shape=(rows.n_rows, order.shape[0])))
+        r_rows.append(rows.fixed_rhs(c[held], value[local_nodes]))
+    A = sp.vstack(A_rows).toarray()
+    A_ser, r_ser = _serial_reduced(n, g.edges, c, fixed, value, diag)
+    # serial rows are in node order of the free nodes; ours in global-number order
+    free = np.flatnonzero(~fixed)
+    perm = np.searchsorted(free, order)                 # serial row of each global number
+    np.testing.assert_allclose(A, A_ser[np.ix_(perm, perm)], rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(np.concatenate(r_rows), r_ser[perm], rtol=1e-14)
+
+
+def test_local_network_refuses_bad_shares():
+    with pytest.raises(GraphError, match="joins two ghosts"):
+        LocalNetwork([0, 1], [5, 6], [1, 1], [[0, 1], [2, 3]])
+    with pytest.raises(GraphError, match="repeats"):
+        LocalNetwork([0, 1], [5], [1], [[0, 1], [1, 0]])
+    with pytest.raises(GraphError, match="key repeats"):
+        LocalNetwork([0, 1], [1], [1], [[0, 2]])
+    with pytest.raises(GraphError, match="ghost_owner"):
+        LocalNetwork([0, 1], [5], [1, 2], [[0, 2]])
+
+
+def _mpiexec(args, n, timeout=600):
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, env.get("PYTHONPATH")) if p)
+    cmd = ["mpiexec", "--oversubscribe", "-n", str(n)] + list(args)
+    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_partitioned_solves_match_the_serial_ones(ranks):
+    pytest.importorskip("mpi4py")
+    res = _mpiexec([sys.executable, os.path.join(ROOT, "tests", "mpi_partition_check.py")], ranks)
+    rows = [json.loads(line) for line in res.stdout.splitlines() if line.startswith("{")]
+    assert res.returncode == 0 and rows, res.stdout[-2000:] + res.stderr[-3000:]
+    out = rows[-1]
+    assert out["ranks"] == ranks
+    for pc in ("deflation", "hypre", "gamg"):
+        r = out[pc]
+        assert r["max_dphi_V"] < 1e-10 and r["R_rel_diff"] < 1e-10 and r["I_a_rel_diff"] < 1e-10, (pc, r)
+        assert abs(r["I_sum"]) < 1e-10 and r["max_dP_rel"] < 1e-9, (pc, r)
+        assert r["floating_ok"] and r["floating_warned"] == out["serial_floating_warned"], (pc, r)
+    for theta in ("0", "0.5", "1"):
+        h = out[f"heat_theta_{theta}"]
+        assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)

@@ -1,0 +1,328 @@
+"""Conduction and heat on a network split between MPI ranks: every call is collective.
+
+Each rank passes its share (:class:`~yade_electro.network.partition.LocalNetwork`: owned
+nodes, the ghosts they touch, the edges with an owned end) and per-edge and per-owned-node
+values; no rank holds the whole graph. The results are on the owned nodes (and, where a
+value of a ghost is needed, fetched from its owner), and the totals (electrode currents,
+R_eq, heat content) are summed over the ranks, so every rank gets the same totals.
+
+* :class:`PartitionedConduction`: the steady potential with fixed-potential electrodes,
+  branch currents, electrode currents, R_eq and Joule heat per element, as
+  :class:`~yade_electro.network.conduction.ConductionProblem` gives them serially;
+* :class:`PartitionedHeat`: ``C dT/dt = -K T + s`` by the theta method (theta = 0 needs no
+  solve: one product with the distributed matrix, whose ghost columns PETSc fetches), with
+  fixed temperatures eliminated, as :class:`~yade_electro.network.transient.HeatSolver`.
+
+Floating parts (connected to no fixed value) follow the serial policy of
+:mod:`yade_electro.network.floating`: in a steady potential they keep 0 V and one warning
+says how many elements in how many parts. They are found without gathering the graph: the
+parts of each rank's share are labelled by their smallest key, and the labels are passed
+across the ranks until no rank's changes.
+
+Units: S, V, A, W for conduction; W/K, J/K, K, W, s for heat.
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Mapping, Optional, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ..core.errors import BoundaryConditionError, ThermalError
+from ..solvers.partitioned import GhostExchange, PartitionedSystem, mpi_comm, number_unknowns, summed
+from .floating import floating_message
+from .partition import LocalNetwork, OwnedRows
+from .theta import theta_of
+
+__all__ = ["PartitionedConduction", "PartitionedHeat", "spread_over_parts", "out_of_owned"]
+
+
+def spread_over_parts(network: LocalNetwork, exchange: GhostExchange, owned_values, op: str = "min") -> np.ndarray:
+    """Each owned node's value made the ``op`` ('min' or 'max') over its whole connected part,
+    across the ranks (collective). Rounds: one per rank boundary a part crosses, plus one."""
+    n, nl = network.n_owned, network.n_local
+    e = network.edges
+    adj = sp.coo_matrix((np.ones(e.shape[0]), (e[:, 0], e[:, 1])), shape=(nl, nl))
+    _, comp = connected_components(adj, directed=False)
+    reduce = np.minimum if op == "min" else np.maximum
+    v = np.asarray(owned_values).copy()
+    while True:
+        full = exchange.local(v)
+        best = np.full(comp.max() + 1 if nl else 0, full.max() if op == "min" else full.min()) if nl else full
+        if nl:
+            reduce.at(best, comp, full)
+            new = best[comp[:n]]
+        else:
+            new = v
+        changed = exchange.comm.allreduce(int(np.count_nonzero(new != v)))
+        v = new
+        if changed == 0:
+            return v
+
+
+class _Share:
+    """What both physics set up on a share: the ghost exchange, the unknowns, the rows."""
+
+    def __init__(self, network: LocalNetwork, fixed_owned, comm, preconditioner, rtol, pos, spacing, options):
+        self.network = network
+        self.comm = mpi_comm(comm)
+        self.exchange = GhostExchange(network, self.comm)
+        fixed = np.asarray(fixed_owned, dtype=bool)
+        if fixed.shape != (network.n_owned,):
+            raise ValueError(f"one fixed flag per owned node ({network.n_owned}), got {fixed.shape}")
+        self.unknown, self.n_global = number_unknowns(self.exchange, fixed)
+        self.rows = OwnedRows(network, self.unknown)
+        coords = None if pos is None else np.asarray(pos, dtype=float).reshape(-1, 3)[self.rows.free_owned]
+        if preconditioner == "deflation" and coords is None:
+            raise ValueError("preconditioner='deflation' needs pos= (the owned nodes' positions, m) and spacing=")
+        self.system = PartitionedSystem(self.rows, self.n_global, self.comm, preconditioner=preconditioner,
+                                        rtol=rtol, coords=coords, spacing=spacing, options=options)
+
+    def total(self, x):
+        """Sum over the ranks."""
+        return self.comm.allreduce(x)
+
+
+class PartitionedConduction:
+    """The steady potential of this rank's share, electrodes held at fixed potentials.
+
+    Parameters
+    ----------
+    network : LocalNetwork
+    conductance : (m,) edge conductances [S] of the share's edges
+    electrode_of : (n_owned,) int
+        The electrode each owned node belongs to (index into ``names``), -1 for none.
+    names : sequence of electrode names; ``values`` their potentials [V] (a mapping or a sequence)
+    comm : mpi4py or petsc4py communicator (default: all ranks)
+    preconditioner : 'deflation' (default, needs ``pos`` and ``spacing``), 'hypre', 'gamg', 'jacobi'
+    pos : (n_owned, 3) positions [m]; spacing : mean neighbour spacing [m]
+    """
+
+    def __init__(self, network: LocalNetwork, conductance, electrode_of, names: Sequence[str], values, *,
+                 comm=None, preconditioner: str = "deflation", rtol: float = 1e-10, pos=None,
+                 spacing: Optional[float] = None, options: Optional[dict] = None):
+        self.names = [str(n) for n in names]
+        el = np.asarray(electrode_of, dtype=np.int64)
+        if el.shape != (network.n_owned,) or (el.size and (el.min() < -1 or el.max() >= len(self.names))):
+            raise BoundaryConditionError(f"electrode_of must give, per owned node, an index into the {len(self.names)} "
+                                         "electrode names or -1")
+        self.values = self._values(values)
+        comm = mpi_comm(comm)
+        ex = GhostExchange(network, comm)
+        held = summed(comm, np.bincount(el[el >= 0], minlength=len(self.names)).astype(np.int64))
+        empty = [n for n, k in zip(self.names, held) if k == 0]
+        if empty:
+            raise BoundaryConditionError(f"electrode(s) {empty} hold no element on any rank: check their selection")
+        reach = spread_over_parts(network, ex, (el >= 0).astype(np.int64), op="max")
+        self.floating = reach == 0
+        n_float = int(comm.allreduce(int(np.count_nonzero(self.floating))))
+        if n_float:
+            part = spread_over_parts(network, ex, network.owned_key, op="min")
+            heads = int(comm.allreduce(int(np.count_nonzero(self.floating & (part == network.owned_key)))))
+            if comm.Get_rank() == 0:
+                warnings.warn(floating_message(n_float, heads, "electrode", "a potential of 0 V"), stacklevel=2)
+        self._share = _Share(network, (el >= 0) | self.floating, comm, preconditioner, rtol, pos, spacing, options)
+        self._share.exchange = ex
+        self.electrode_of = el
+        self._el_local = ex.local(np.where(self.floating, len(self.names), el))
+        self._x = None
+        self.update_conductance(conductance)
+
+    def _values(self, values) -> np.ndarray:
+        if isinstance(values, Mapping):
+            missing = [n for n in self.names if n not in values]
+            if missing:
+                raise BoundaryConditionError(f"no potential given for electrode(s) {missing}")
+            v = [values[n] for n in self.names]
+        else:
+            v = list(values)
+            if len(v) != len(self.names):
+                raise BoundaryConditionError(f"{len(v)} potentials for {len(self.names)} electrodes")
+        v = np.asarray(v, dtype=float)
+        if not np.all(np.isfinite(v)):
+            raise BoundaryConditionError(f"electrode potentials must be finite (V), got {v.tolist()}")
+        return v
+
+    @property
+    def network(self) -> LocalNetwork:
+        return self._share.network
+
+    def update_conductance(self, conductance):
+        """New edge conductances [S], same edges (collective); the setup is kept."""
+        c = np.asarray(conductance, dtype=float)
+        if c.shape != (self.network.edges.shape[0],) or not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise BoundaryConditionError("conductances must be finite and >= 0 (S), one per edge of the share")
+        self.conductance = c
+        s = self._share
+        s.system.set_values(s.rows.values(c), s.exchange)
+
+    def solve(self, values=None):
+        """The potential [V] on the local nodes (owned, then ghosts) (collective)."""
+        if values is not None:
+            self.values = self._values(values)
+        s = self._share
+        fixed = np.append(self.values, 0.0)[self._el_local]
+        rhs = s.rows.fixed_rhs(self.conductance, fixed)
+        x, self.info = s.system.solve(rhs, x0=self._x)
+        self._x = x
+        own = fixed[:self.network.n_owned].copy()
+        own[s.rows.free_owned] = x
+        self.potential = s.exchange.local(own)
+        return self.potential
+
+    def branch_current(self) -> np.ndarray:
+        """Current [A] of each edge of the share, from its first node to its second."""
+        e = self.network.edges
+        return self.conductance * (self.potential[e[:, 0]] - self.potential[e[:, 1]])
+
+    def electrode_currents(self) -> dict:
+        """Current [A] leaving each electrode into the network, summed over the ranks."""
+        out = out_of_owned(self.network, self.branch_current())
+        el = self.electrode_of
+        mine = np.bincount(el[el >= 0], out[el >= 0], len(self.names))
+        total = summed(self._share.comm, mine)
+        return dict(zip(self.names, total.tolist()))
+
+    def equivalent_resistance(self, a: Optional[str] = None, b: Optional[str] = None) -> float:
+        """(V_a - V_b) / I_a between two electrodes [ohm] (the first two by default)."""
+        a = self.names[0] if a is None else a
+        b = self.names[1] if b is None else b
+        va, vb = self.values[self.names.index(a)], self.values[self.names.index(b)]
+        i = self.electrode_currents()[a]
+        return float((va - vb) / i) if i != 0 else float("inf")
+
+    def joule_power(self) -> np.ndarray:
+        """Joule heat [W] of each owned node: each edge's c dV^2 shared half and half by its ends."""
+        e = self.network.edges
+        p = self.conductance * (self.potential[e[:, 0]] - self.potential[e[:, 1]]) ** 2
+        n = self.network.n_owned
+        out = np.zeros(n)
+        for col in (0, 1):
+            mine = e[:, col] < n
+            out += 0.5 * np.bincount(e[mine, col], p[mine], n)
+        return out
+
+
+class PartitionedHeat:
+    """``C dT/dt = -K T - h A (T - T_inf) + P`` on this rank's share, by the theta method.
+
+    Parameters
+    ----------
+    network : LocalNetwork
+    capacity : (n_owned,) heat capacities [J/K] > 0
+    conductance : (m,) thermal conductances [W/K] of the share's edges
+    temperature : float or (n_owned,) initial temperatures [K]
+    fixed : (n_owned,) float, NaN where free, the held temperature [K] elsewhere; optional
+    h_area, t_inf : (n_owned,) convection h A [W/K] and ambient temperature [K]; optional
+    theta : as :func:`~yade_electro.network.theta.theta_of` (default backward Euler)
+    """
+
+    def __init__(self, network: LocalNetwork, capacity, conductance, temperature, *, fixed=None, h_area=None,
+                 t_inf=None, theta="backward-euler", comm=None, preconditioner: str = "deflation",
+                 rtol: float = 1e-12, pos=None, spacing: Optional[float] = None, options: Optional[dict] = None):
+        n = network.n_owned
+        C = np.asarray(capacity, dtype=float)
+        if C.shape != (n,) or not np.all(np.isfinite(C)) or np.any(C <= 0):
+            raise ThermalError(f"heat capacities must be finite and > 0 (J/K), one per owned node ({n})")
+        self.capacity = C
+        self.fixed = np.full(n, np.nan) if fixed is None else np.asarray(fixed, dtype=float)
+        self.h_area = np.zeros(n) if h_area is None else np.asarray(h_area, dtype=float)
+        self.t_inf = np.zeros(n) if t_inf is None else np.asarray(t_inf, dtype=float)
+        self.theta = theta_of(theta)
+        held = ~np.isnan(self.fixed)
+        self._share = _Share(network, held, comm, preconditioner, rtol, pos, spacing, options)
+        self._held = held
+        T = np.broadcast_to(np.asarray(temperature, dtype=float), (n,)).copy()
+        T[held] = self.fixed[held]
+        self.T = T
+        self.time = 0.0
+        self._dT = None
+        self.update_conductance(conductance)
+
+    @property
+    def network(self) -> LocalNetwork:
+        return self._share.network
+
+    def update_conductance(self, conductance):
+        """New edge conductances [W/K], same edges (collective)."""
+        c = np.asarray(conductance, dtype=float)
+        if c.shape != (self.network.edges.shape[0],) or not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise ThermalError("thermal conductances must be finite and >= 0 (W/K), one per edge of the share")
+        self.conductance = c
+        self._dt = None                         # the step matrix is made again at the next step
+
+    def _free(self, a):
+        return np.asarray(a)[self._share.rows.free_owned]
+
+    def flow(self, T_owned=None) -> np.ndarray:
+        """``(K T)_i + h_i A_i T_i`` [W] on every owned node: the heat it gives its neighbours
+        (fixed ones too) and the ambient's h A T part (collective: ghosts from their owners)."""
+        T0 = self.T if T_owned is None else np.asarray(T_owned, dtype=float)
+        T = self._share.exchange.local(T0)
+        e = self.network.edges
+        return out_of_owned(self.network, self.conductance * (T[e[:, 0]] - T[e[:, 1]])) + self.h_area * T0
+
+    def stable_time_step(self) -> float:
+        """The forward-Euler bound min C_i / (sum_j G_ij + h_i A_i) over the free nodes [s], all ranks."""
+        from mpi4py import MPI
+        e, n = self.network.edges, self.network.n_owned
+        d = self.h_area.copy()
+        for col in (0, 1):
+            mine = e[:, col] < n
+            d += np.bincount(e[mine, col], self.conductance[mine], n)
+        sel = (d > 0) & ~self._held
+        mine = float(np.min(self.capacity[sel] / d[sel])) if np.any(sel) else np.inf
+        return self._share.comm.allreduce(mine, op=MPI.MIN)
+
+    def advance(self, dt: float, power=None) -> np.ndarray:
+        """One step of ``dt`` [s] with sources ``power`` [W] per owned node held over it; returns
+        the owned temperatures [K] (collective). The change dT of the free nodes solves
+        ``(C/dt + theta K_uu) dT = s - K T`` (no solve for theta = 0); forward Euler above its
+        bound raises, and a failed step leaves the state as it was."""
+        if not (dt > 0 and np.isfinite(dt)):
+            raise ThermalError(f"the time step must be finite and > 0 (s), got {dt}")
+        s, th = self._share, self.theta
+        n = self.network.n_owned
+        P = np.zeros(n) if power is None else np.asarray(power, dtype=float)
+        if P.shape != (n,) or not np.all(np.isfinite(P)):
+            raise ThermalError(f"sources must be finite (W), one per owned node ({n})")
+        if th < 0.5:
+            bound = self.stable_time_step() / (1.0 - 2.0 * th)
+            if dt > bound:
+                raise ThermalError(f"dt = {dt:.3e} s is above the stable step {bound:.3e} s of theta = {th:g}; "
+                                   "take smaller steps or theta >= 1/2")
+        rhs = self._free(self.h_area * self.t_inf + P - self.flow())
+        Cdt = self.capacity / dt
+        if th == 0.0:
+            dT = rhs / self._free(Cdt)
+        else:
+            if self._dt != dt:                  # the step matrix for this dt and these conductances
+                s.system.set_values(s.rows.values(th * self.conductance, th * self.h_area + Cdt), s.exchange)
+            dT, self.info = s.system.solve(rhs, x0=self._dT)
+            self._dT = dT
+        self._dt = dt
+        new = self._free(self.T) + dT
+        if not np.all(np.isfinite(new)):
+            raise ThermalError("the heat step gave non-finite temperatures; the state is kept")
+        T = self.T.copy()
+        T[s.rows.free_owned] = new
+        self.T = T
+        self.time += dt
+        return T
+
+    def heat_content(self, reference: float = 0.0) -> float:
+        """sum C (T - reference) [J] over all ranks."""
+        return float(self._share.total(float(self.capacity @ (self.T - reference))))
+
+
+def out_of_owned(network: LocalNetwork, per_edge) -> np.ndarray:
+    """Sum over each owned node's edges of ``per_edge`` (a flow from an edge's first node to
+    its second), counted out of the node."""
+    n, e = network.n_owned, network.edges
+    out = np.zeros(n)
+    for col, sign in ((0, 1.0), (1, -1.0)):
+        mine = e[:, col] < n
+        out += np.bincount(e[mine, col], sign * per_edge[mine], n)
+    return out
