@@ -44,19 +44,13 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..core.errors import SolverError
-from .petsc import import_petsc
+from .petsc import HYPRE_3D, check_preconditioner, import_petsc
 
 __all__ = ["GhostExchange", "number_unknowns", "PartitionedSystem", "PRECONDITIONERS", "mpi_comm",
            "cluster_labels", "summed"]
 
 #: the preconditioners of a partitioned solve
 PRECONDITIONERS = ("deflation", "hypre", "gamg", "jacobi")
-
-#: BoomerAMG's options for 3-D problems (hypre's own advice for 3-D diffusion)
-HYPRE_3D = {"pc_hypre_type": "boomeramg", "pc_hypre_boomeramg_coarsen_type": "HMIS",
-            "pc_hypre_boomeramg_interp_type": "ext+i", "pc_hypre_boomeramg_P_max": "4",
-            "pc_hypre_boomeramg_agg_nl": "1", "pc_hypre_boomeramg_strong_threshold": "0.5"}
-
 
 def mpi_comm(comm=None):
     """The mpi4py communicator of ``comm`` (an mpi4py or petsc4py one; default: PETSc's
@@ -243,10 +237,7 @@ class PartitionedSystem:
             raise ValueError(f"preconditioner must be one of {', '.join(PRECONDITIONERS)}, got {preconditioner!r}")
         if not (0 < rtol < 1):
             raise ValueError(f"rtol must be in (0, 1), got {rtol}")
-        self.PETSc = import_petsc()
-        if preconditioner == "hypre" and not self.PETSc.Sys.hasExternalPackage("hypre"):
-            raise SolverError("preconditioner='hypre' needs PETSc built with hypre (Debian's libpetsc-real3.18 has it); "
-                              "use preconditioner='deflation' or 'gamg'")
+        self.PETSc = check_preconditioner(preconditioner)
         if preconditioner == "deflation" and (coords is None or spacing is None):
             raise ValueError("preconditioner='deflation' needs coords= (the owned unknowns' positions) and spacing=")
         self.rows, self.n_global, self.comm = rows, int(n_global), comm
@@ -308,7 +299,7 @@ class PartitionedSystem:
             self.matrix.setValuesCSR(ip, ix, data)
             self.matrix.assemble()
             self._ksp.setOperators(self.matrix)
-            self._ksp.setReusePreconditioner(True)
+            self._ksp.getPC().setReusePreconditioner(True)
         self._data = data
         if self.preconditioner == "deflation" and self._deflation.factor is None:
             self._deflation.build(data)
@@ -346,7 +337,7 @@ class PartitionedSystem:
         t = time.perf_counter()
         if self.preconditioner == "deflation":
             self._deflation.build(self._data)
-        self._ksp.setReusePreconditioner(False)
+        self._ksp.getPC().setReusePreconditioner(False)
         self._ksp.setOperators(self.matrix)
         self.setups += 1
         self._base_iterations = None

@@ -36,7 +36,13 @@ import scipy.sparse as sp
 from ..core.errors import SolverError
 from .base import Solver
 
-__all__ = ["PETScSolver", "import_petsc", "petsc_available", "petsc4py_location"]
+__all__ = ["PETScSolver", "import_petsc", "petsc_available", "petsc4py_location", "check_preconditioner", "HYPRE_3D"]
+
+#: BoomerAMG's options for 3-D problems (hypre's advice for 3-D diffusion: HMIS coarsening,
+#: ext+i interpolation, at most 4 entries per row of P, one level of aggressive coarsening)
+HYPRE_3D = {"pc_hypre_type": "boomeramg", "pc_hypre_boomeramg_coarsen_type": "HMIS",
+            "pc_hypre_boomeramg_interp_type": "ext+i", "pc_hypre_boomeramg_P_max": "4",
+            "pc_hypre_boomeramg_agg_nl": "1", "pc_hypre_boomeramg_strong_threshold": "0.5"}
 
 #: where Debian 12's python3-petsc4py puts the module (one directory per PETSc build)
 DEBIAN_PETSC4PY = "/usr/lib/petscdir/petsc*/*-real/lib/python3/dist-packages"
@@ -82,6 +88,15 @@ def import_petsc():
     raise SolverError(_INSTALL_HINT)
 
 
+def check_preconditioner(preconditioner: str):
+    """The PETSc module, or SolverError when petsc4py or (for 'hypre') PETSc's hypre is missing."""
+    PETSc = import_petsc()
+    if preconditioner == "hypre" and not PETSc.Sys.hasExternalPackage("hypre"):
+        raise SolverError("the 'hypre' preconditioner needs PETSc built with hypre (Debian's libpetsc-real3.18 has "
+                          "it); use solver='petsc' (GAMG or our deflation) or 'cg-deflated'")
+    return PETSc
+
+
 def petsc_available() -> bool:
     """True when :func:`import_petsc` works."""
     try:
@@ -101,8 +116,9 @@ class PETScSolver(Solver):
         Stop when ||A x - b|| <= rtol ||b|| (default 1e-10).
     maxiter : int, optional
         Default 10 n.
-    preconditioner : {'gamg', 'jacobi', 'none'}
-        GAMG by default; Jacobi to compare with ``'cg'``.
+    preconditioner : {'gamg', 'hypre', 'jacobi', 'none'}
+        GAMG by default; BoomerAMG with the 3-D options :data:`HYPRE_3D`; Jacobi to compare
+        with ``'cg'``.
     comm : petsc4py communicator, optional
         ``PETSc.COMM_WORLD`` by default (all ranks of ``mpiexec``); ``PETSc.COMM_SELF`` for a
         rank-local solve.
@@ -117,10 +133,10 @@ class PETScSolver(Solver):
                  comm=None, options: Optional[dict] = None):
         if not (0 < rtol < 1):
             raise ValueError(f"rtol must be in (0, 1), got {rtol}")
-        if preconditioner not in ("gamg", "jacobi", "none"):
-            raise ValueError(f"preconditioner must be 'gamg', 'jacobi' or 'none', got {preconditioner!r}")
+        if preconditioner not in ("gamg", "hypre", "jacobi", "none"):
+            raise ValueError(f"preconditioner must be 'gamg', 'hypre', 'jacobi' or 'none', got {preconditioner!r}")
         super().__init__()
-        self.PETSc = import_petsc()
+        self.PETSc = check_preconditioner(preconditioner)
         self.comm = self.PETSc.COMM_WORLD if comm is None else comm
         self.rtol, self.maxiter, self.preconditioner = float(rtol), maxiter, preconditioner
         self.options = dict(options or {})
@@ -165,8 +181,12 @@ class PETScSolver(Solver):
         ksp.setType(PETSc.KSP.Type.CG)
         ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
         pc = ksp.getPC()
-        pc.setType({"gamg": PETSc.PC.Type.GAMG, "jacobi": PETSc.PC.Type.JACOBI,
+        pc.setType({"gamg": PETSc.PC.Type.GAMG, "hypre": PETSc.PC.Type.HYPRE, "jacobi": PETSc.PC.Type.JACOBI,
                     "none": PETSc.PC.Type.NONE}[self.preconditioner])
+        if self.preconditioner == "hypre":
+            for k, val in HYPRE_3D.items():
+                if not opts.hasName("ye_" + k):
+                    opts["ye_" + k] = val
         if self.preconditioner == "gamg":
             opts["ye_pc_gamg_type"] = opts.getString("ye_pc_gamg_type", "agg")
             opts["ye_pc_gamg_reuse_interpolation"] = "true"

@@ -27,9 +27,12 @@ Solvers
     its finest operator replaced; it is rebuilt when an iteration count exceeds
     ``resetup_factor`` (1.5) times the count of the first solve after the last setup, i.e.
     when the kept hierarchy no longer fits the matrix (large value changes).
-``'petsc'``
-    PETSc's CG + GAMG through petsc4py, distributed over the ranks of ``mpiexec`` (see
-    :mod:`yade_electro.solvers.petsc`; imported only when asked for).
+``'petsc'``, ``'petsc-hypre'``, ``'petsc-gamg'``
+    PETSc's CG through petsc4py (imported only when asked for). On one rank, preconditioned
+    by GAMG (``'petsc'``, ``'petsc-gamg'``) or BoomerAMG (``'petsc-hypre'``), see
+    :mod:`yade_electro.solvers.petsc`. An engine under ``mpiexec`` with more than one rank
+    runs distributed (:mod:`yade_electro.solvers.partitioned`): ``'petsc'`` then
+    preconditions with our deflation.
 ``'direct'``
     Sparse LU (SuperLU). ``update``: refactorisation (there is no cheaper exact update).
 ``'auto'``
@@ -85,7 +88,7 @@ _SOLVERS = {"direct": DirectSolver, "cg": CGSolver, "cg-jacobi": CGSolver, "cg-d
 
 
 #: solvers in modules of their own, imported when asked for (their dependencies are optional)
-_LAZY_SOLVERS = ("petsc",)
+_LAZY_SOLVERS = ("petsc", "petsc-hypre", "petsc-gamg")
 
 
 def solver_names() -> tuple:
@@ -102,9 +105,9 @@ def make_solver(solver="auto", n_unknowns: Optional[int] = None, **kw):
         if n_unknowns is None:
             raise ValueError("solver='auto' needs the number of unknowns")
         solver = auto_solver_name(n_unknowns)
-    if solver == "petsc":
+    if solver in _LAZY_SOLVERS:
         from .petsc import PETScSolver
-        return PETScSolver(**kw)
+        return PETScSolver(**{"preconditioner": "hypre" if solver == "petsc-hypre" else "gamg", **kw})
     try:
         cls = _SOLVERS[solver]
     except (KeyError, TypeError):
@@ -124,6 +127,6 @@ def check_solver_name(solver) -> None:
         return
     if solver != "auto" and solver not in _SOLVERS and solver not in _LAZY_SOLVERS:
         raise ValueError(f"unknown solver {solver!r}; known: {', '.join(solver_names())}")
-    if solver == "petsc":                # missing petsc4py: say so when the engine is built
-        from .petsc import import_petsc
-        import_petsc()
+    if solver in _LAZY_SOLVERS:          # missing petsc4py or hypre: say so when the engine is built
+        from .petsc import check_preconditioner
+        check_preconditioner("hypre" if solver == "petsc-hypre" else "gamg")

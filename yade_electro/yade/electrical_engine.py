@@ -43,6 +43,7 @@ from . import registry
 from .granular import check_wall_bodies
 from .scene import write_body_attribute
 
+from .distributed import DistributedCalls, distributed_model
 from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
 from .options import Electrode, Output, Reader, electrical_settings
 __all__ = ["ElectricalEngine"]
@@ -217,6 +218,15 @@ class ElectricalEngine(EngineBase):
         self._feed_electrode_walls()
         self._apply_materials()
         self.model.update(graph)
+
+    def _distributed_calls(self, graph):
+        ids = {name: graph.ids[m.nodes(graph)] for name, m in self.model.memberships.items()
+               if any(s.name == name and s.surface is None and not s.wall for s in self.model.specs)}
+        model = distributed_model(solver=self._options["solver"], resistivity=self._resistivity,
+                                  materials=self._materials_config, law=self._options["law"],
+                                  law_params=self._law_params, electrodes=self.model.specs, electrode_ids=ids,
+                                  walls=self._declared_walls)
+        return DistributedCalls(self.O, self.reader, model, write_back=self.write_back)
 
     def _material_base(self):
         return {"resistivity": self._resistivity}

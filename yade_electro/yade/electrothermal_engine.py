@@ -21,6 +21,7 @@ from .runtime import import_yade
 from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
+from .distributed import DistributedCalls, distributed_model
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
 from .options import Output, Reader, thermal_settings
@@ -166,6 +167,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         # selectors made picklable; the model checks what each condition is (split_heat_boundaries)
         conditions = [bc if getattr(bc, "nodes", None) is None else dataclasses.replace(
             bc, nodes=self._normalise_selector(bc.nodes)) for bc in heat_conditions]
+        self._heat_conditions = conditions
+        self._initial_by_id = initial_temperature is not None
         if not isinstance(steady, bool):
             raise ValueError(f"steady must be True or False, got {steady!r}")
         self.steady = steady
@@ -348,6 +351,28 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                 "fixed_values": heat.fixed_values if heat is not None else {},
                 "pending": {str(k): v for k, v in self._pending_temperatures.items()},
                 "rows": len(self.history)}
+
+    def _distributed_calls(self, graph):
+        t, c = self._thermal, self._coupled
+        if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id:
+            raise BoundaryConditionError("a distributed run (solver='petsc' under mpiexec) does not do steady states, "
+                                         "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
+        specs = self.model.specs if self.model is not None else ()
+        ids = {name: graph.ids[m.nodes(graph)] for name, m in (self.model.memberships.items() if self.model else ())
+               if any(s.name == name and s.surface is None and not s.wall for s in specs)}
+        cond_ids = {name: graph.ids[m.nodes(graph)] for name, m in c.bc_memberships.items()
+                    if any(b.name == name and getattr(b, "surface", None) is None for b in self._heat_conditions)}
+        vf = c.volume_fraction if not callable(c.volume_fraction) else None
+        heat = dict(density=t["density"], specific_heat=t["specific_heat"], conductivity=t["conductivity"],
+                    temperature=t["temperature"], beta=t["beta"], eta=t["eta"], theta=t["theta"],
+                    reference_temperature=t["coupled_options"].get("reference_temperature"), volume_fraction=vf)
+        model = distributed_model(solver=self._options["solver"], resistivity=self._resistivity,
+                                  materials=self._materials_config, law=self._options["law"] or "continuum",
+                                  law_params=self._law_params, electrodes=specs, electrode_ids=ids, heat=heat,
+                                  conditions=self._heat_conditions, condition_ids=cond_ids,
+                                  walls=self._declared_walls)
+        return DistributedCalls(self.O, self.reader, model, write_back=self.write_back, temperatures=True,
+                                thermal_dt=self.thermal_dt, time_scale=self.time_scale)
 
     def _prepare(self, graph):
         if self._resume is not None and self.model is not None:

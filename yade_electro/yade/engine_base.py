@@ -21,6 +21,7 @@ from ..core.materials import real_number
 from . import persistence
 from . import registry
 from .runtime import MPY_REFUSAL, import_yade, in_mpy_subdomain
+from .distributed import distributed_requested, world_rank
 from .granular import GranularReader
 from .scene import SceneReader, check_write_back, predicate_selector
 
@@ -245,7 +246,15 @@ class EngineBase:
         """After the model is built: first read, checks, history, runner, saved config."""
         graph = self.reader.read()                  # no spheres: GraphError here, in the script
         check_write_back(self.write_back, self.reader.bodies)
-        self._prepare(graph)                        # selections, structure: their errors here too
+        self._distributed = None
+        if distributed_requested(self._options.get("solver")):
+            if self._resume is not None:
+                raise RuntimeError(f"engine {self.label!r}: a distributed run does not continue a saved one yet")
+            self._distributed = self._distributed_calls(graph)     # its errors here, in the script
+            if world_rank() != 0:
+                self.history_path = None            # rank 0 writes the history
+        else:
+            self._prepare(graph)                    # selections, structure: their errors here too
         mode = "a" if self._resume is not None else history_mode
         self._history = History(self.history_path, mode)
         registry.check_shared_outputs(self)
@@ -355,6 +364,10 @@ class EngineBase:
         try:
             if self.removed:
                 raise RuntimeError(f"engine {self.label!r} was removed")
+            if self._distributed is not None:
+                out = self._distributed.call()
+                self._write_row(out)
+                return out
             if in_mpy_subdomain():
                 raise RuntimeError(MPY_REFUSAL.format(label=self.label))
             if self._reader.scene_replaced:
@@ -367,6 +380,17 @@ class EngineBase:
             raise
         self._save_state()
         return out
+
+    _distributed = None
+
+    def _distributed_calls(self, graph):
+        """The DistributedCalls of this engine on the first ``graph`` (a subclass's)."""
+        raise BoundaryConditionError(f"{type(self).__name__} does not run distributed; use solver='cg-deflated'")
+
+    @property
+    def distributed(self) -> bool:
+        """True when the engine runs distributed over the ranks of mpiexec (solver='petsc')."""
+        return self._distributed is not None
 
     def _write_row(self, row):
         self.history.append(row)

@@ -1,0 +1,297 @@
+"""Conduction, Joule heat and heat on a packing split between MPI ranks (numpy + MPI, no YADE).
+
+Each rank gives, at each call, its share of the packing as a :class:`Share`: a contact graph
+whose first ``n_owned`` nodes are the elements it owns and the rest the ghosts they touch (other
+ranks' elements), with the edges that have an owned end. :class:`DistributedElectroThermal`
+then does what :class:`~yade_electro.physics.coupled.ElectroThermalModel` does serially, every
+call collective:
+
+* the geometric factors of the law on the share's edges: the contact laws need the pair only;
+  the continuum law's transmission surface S_i needs an element's whole neighbourhood, so each
+  owner computes it for its own elements and sends it to the ranks that see them as ghosts;
+* conductances ``g / rho_edge(T)`` (the mean of the two ends' rho_e(T), ghosts' temperatures
+  from their owners) and ``lambda g``;
+* the potential with fixed-potential electrodes, branch currents, R_eq, Joule heat per element;
+* the heat step by the theta method with fixed temperatures and convection.
+
+What it does not do (yet) raises :class:`~yade_electro.core.errors.BoundaryConditionError`
+when the engine is built: the 'voronoi' law (its tessellation is global), surface and wall
+electrodes, current-driven electrodes, per-material tables, heat fluxes, sources and walls.
+
+Units: SI (m, ohm m, S, V, A, W, K, J/K, W/K, s).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, Optional, Sequence
+
+import numpy as np
+
+from ..core.errors import BoundaryConditionError
+from ..core.graph import ContactGraph
+from ..core.materials import Material, electrical_conductance, thermal_conductance_of
+from ..laws.factors import edge_lengths, is_contact_law, make_law
+from ..laws.transmission import exposed_area, transmission_surface, volume_fraction
+from ..network.distributed import PartitionedConduction, PartitionedHeat
+from ..network.partition import LocalNetwork, split_network
+from ..solvers.partitioned import GhostExchange, mpi_comm, summed
+
+__all__ = ["Share", "carve_share", "DistributedElectroThermal", "Held", "Exchange", "DISTRIBUTED_LAWS"]
+
+#: the laws a distributed run computes
+DISTRIBUTED_LAWS = ("continuum", "contact", "liggghts", "pipe")
+
+
+@dataclass(frozen=True, eq=False)
+class Share:
+    """One rank's share of the packing: ``graph`` (owned nodes first, then ghosts; None when
+    the rank owns nothing) and its ``network`` (the same nodes and edges, with the ghosts'
+    owners)."""
+
+    graph: Optional[ContactGraph]
+    network: LocalNetwork
+
+    @property
+    def n_owned(self) -> int:
+        return self.network.n_owned
+
+    @property
+    def owned_ids(self) -> np.ndarray:
+        return self.network.owned_key
+
+
+def carve_share(graph: Optional[ContactGraph], owner, rank: int) -> Share:
+    """The share of rank ``rank`` of a graph of the elements it has (the whole packing, or its
+    own and mirrored ones), ``owner[i]`` the rank owning node i. The share's edges are the
+    graph's edges with an owned end, in the graph's order."""
+    if graph is None:
+        return Share(None, LocalNetwork([], [], [], np.zeros((0, 2), np.int64)))
+    owner = np.asarray(owner, dtype=np.int64)
+    network, held = split_network(graph.n_nodes, graph.edges, owner, rank, keys=graph.ids)
+    if network.n_owned == 0:
+        return Share(None, network)
+    nodes = np.concatenate([np.flatnonzero(owner == rank), graph.index_of(network.ghost_key)])
+    sub = ContactGraph(graph.pos[nodes], graph.radius[nodes], network.edges, ids=graph.ids[nodes],
+                       revision=graph.revision)
+    return Share(sub, LocalNetwork(network.owned_key, network.ghost_key, network.ghost_owner, sub.edges))
+
+
+@dataclass(frozen=True)
+class Held:
+    """Elements held at a value: an electrode at ``value`` V or a fixed temperature at ``value``
+    K, chosen by ``select`` (body ids, or a callable ``f(pos, radius) -> mask`` evaluated once on
+    the first share and then kept by id on every rank)."""
+
+    name: str
+    select: object
+    value: float
+
+
+@dataclass(frozen=True)
+class Exchange:
+    """Convection ``h A (t_inf - T)`` on the elements ``select`` chose; ``area`` [m^2] a
+    scalar, or None for the exposed area of the continuum model."""
+
+    name: str
+    select: object
+    h: float
+    t_inf: float
+    area: Optional[float] = None
+
+
+class DistributedElectroThermal:
+    """See the module doc.
+
+    Parameters
+    ----------
+    material : Material
+        Scalars: resistivity (with electrodes), beta and reference_temperature, density,
+        specific_heat and conductivity (with heat).
+    law : str
+        One of :data:`DISTRIBUTED_LAWS`; ``law_params`` its parameters.
+    electrodes : list of Held (potentials [V])
+    fixed : list of Held (temperatures [K]); convection : list of Exchange
+    temperature : float, initial temperature [K]; None: no heat (conduction only)
+    theta : the integrator's theta; eta : the share of the Joule power turned into heat
+    volume_fraction : float or None (the continuum model's from the bonds)
+    preconditioner : of the partitioned solves ('deflation', 'hypre', 'gamg', 'jacobi')
+    comm : mpi4py or petsc4py communicator (default all ranks)
+    """
+
+    def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
+                 electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
+                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
+                 volume_fraction: Optional[float] = None, preconditioner: str = "deflation", rtol: float = 1e-10,
+                 comm=None):
+        if law not in DISTRIBUTED_LAWS:
+            raise BoundaryConditionError(f"a distributed run computes the laws {', '.join(DISTRIBUTED_LAWS)}; law "
+                                         f"{law!r} is not one of them (the 'voronoi' law's tessellation is global)")
+        self.material, self.law_name = material, law
+        self.law = make_law(law, **dict(law_params or {}))
+        self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
+        self.temperature0 = temperature
+        self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
+        self.preconditioner, self.rtol = preconditioner, float(rtol)
+        self.comm = mpi_comm(comm)
+        self._ids: Dict[str, np.ndarray] = {}
+        self._T_by_id: Optional[Dict[int, float]] = None
+        self.share: Optional[Share] = None
+        self.conduction: Optional[PartitionedConduction] = None
+        self.heat: Optional[PartitionedHeat] = None
+        self.time = 0.0
+        self.joule_energy = 0.0
+
+    # -- the share and its values ------------------------------------------------------------
+    def _chosen(self, item, share: Share) -> np.ndarray:
+        """Mask of the owned nodes ``item`` holds (its ids fixed on the first share, all ranks)."""
+        if item.name not in self._ids:
+            mine = np.zeros(0, np.int64)
+            if share.graph is not None:
+                n = share.n_owned
+                if callable(item.select):
+                    mask = np.asarray(item.select(share.graph.pos[:n], share.graph.radius[:n]), dtype=bool)
+                    mine = share.owned_ids[mask]
+                else:
+                    mine = share.owned_ids[np.isin(share.owned_ids, np.asarray(item.select, np.int64))]
+            ids = np.unique(np.concatenate(self.comm.allgather(mine)))
+            if ids.size == 0:
+                raise BoundaryConditionError(f"{item.name!r} selects no element on any rank: check its region/ids "
+                                             "against the packing (selection is by element centre)")
+            self._ids[item.name] = ids
+        return np.isin(share.owned_ids, self._ids[item.name])
+
+    def _factor(self, share: Share, exchange: GhostExchange) -> np.ndarray:
+        g = share.graph
+        if g is None:
+            return np.zeros(0)
+        if is_contact_law(self.law_name):
+            return self.law.factor(g, g.edges)
+        S = transmission_surface(g, threshold=self.law.threshold, factor=self.law.factor_)
+        S = exchange.local(S[:share.n_owned])
+        return np.sqrt(S[g.edges[:, 0]] * S[g.edges[:, 1]]) / edge_lengths(g, g.edges)
+
+    def _capacity(self, share: Share) -> np.ndarray:
+        g, n, m = share.graph, share.n_owned, self.material
+        if g is None:
+            return np.zeros(0)
+        fv = volume_fraction(g)[:n] if self.volume_fraction is None else self.volume_fraction
+        return m.density * m.specific_heat * g.volume[:n] / fv
+
+    def _conductance(self, T_owned) -> np.ndarray:
+        """Electrical conductances [S] of the share's edges at the owned temperatures [K]
+        (rho_e(T) of the ghosts from their owners)."""
+        m = self.material
+        rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(T_owned, float))
+        if np.ndim(rho):
+            rho = self._exchange.local(rho)
+        return electrical_conductance(self.factor, rho, self.share.network.edges)
+
+    def _thermal(self) -> np.ndarray:
+        """Thermal conductances [W/K] of the share's edges."""
+        return thermal_conductance_of(self.factor, self.material.conductivity, self.share.network.edges)
+
+    def prepare(self, share: Share):
+        """Set up the solves on a new share (new element set or edges), carrying the temperatures
+        of the elements kept (by id)."""
+        self.share = share
+        net = share.network
+        exchange = GhostExchange(net, self.comm)
+        self._exchange = exchange
+        self.factor = self._factor(share, exchange)
+        n = share.n_owned
+        pos = share.graph.pos[:n] if share.graph is not None else np.zeros((0, 3))
+        spacing = self._spacing(share)
+        T = self._temperatures(share)
+        self.T = T
+        if self.electrodes:
+            el = np.full(n, -1, np.int64)
+            for k, item in enumerate(self.electrodes):
+                el[self._chosen(item, share)] = k
+            self.conduction = PartitionedConduction(
+                net, self._conductance(T), el, [e.name for e in self.electrodes],
+                [e.value for e in self.electrodes], comm=self.comm, preconditioner=self.preconditioner,
+                rtol=self.rtol, pos=pos, spacing=spacing)
+        if self.temperature0 is not None:
+            fixed = np.full(n, np.nan)
+            for item in self.fixed:
+                fixed[self._chosen(item, share)] = item.value
+            hA, t_inf = np.zeros(n), np.zeros(n)
+            for item in self.convection:
+                on = self._chosen(item, share)
+                area = (exposed_area(share.graph)[:n] if item.area is None else np.full(n, float(item.area))) \
+                    if share.graph is not None else np.zeros(0)
+                t_inf[on] = (t_inf[on] * hA[on] + item.h * area[on] * item.t_inf) / np.maximum(
+                    hA[on] + item.h * area[on], 1e-300)
+                hA[on] += item.h * area[on]
+            self.heat = PartitionedHeat(net, self._capacity(share), self._thermal(), T,
+                                        fixed=fixed, h_area=hA, t_inf=t_inf, theta=self.theta, comm=self.comm,
+                                        preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing)
+            self.T = self.heat.T
+
+    def _spacing(self, share: Share) -> float:
+        """Mean edge length over all ranks [m] (the deflation's cluster unit)."""
+        g = share.graph
+        local = edge_lengths(g, g.edges) if g is not None and g.n_edges else np.zeros(0)
+        s = summed(self.comm, np.array([local.sum(), float(local.size)]))
+        return float(s[0] / s[1]) if s[1] > 0 else 1.0
+
+    def _temperatures(self, share: Share) -> np.ndarray:
+        n = share.n_owned
+        T0 = float(self.temperature0) if self.temperature0 is not None else float(
+            self.material.reference_temperature or 0.0)
+        if self._T_by_id is None:
+            return np.full(n, T0)
+        return np.array([self._T_by_id.get(int(i), T0) for i in share.owned_ids.tolist()])
+
+    # -- one call ----------------------------------------------------------------------------
+    def step(self, share: Share, dt: Optional[float]) -> dict:
+        """One call on ``share`` (a new element set or edge set rebuilds the solves, else the
+        values are refreshed in place): the potential, the Joule heat, and a heat step of
+        ``dt`` [s] (None or 0: no heat step). Returns the totals of all ranks."""
+        same = (self.share is not None and share.network.edges.shape == self.share.network.edges.shape
+                and np.array_equal(share.network.owned_key, self.share.network.owned_key)
+                and np.array_equal(share.network.ghost_key, self.share.network.ghost_key)
+                and np.array_equal(share.network.edges, self.share.network.edges))
+        if not same:
+            if self.share is not None:
+                self._T_by_id = dict(zip(self.share.owned_ids.tolist(), self.T.tolist()))
+            self.prepare(share)
+        else:
+            self.share = share
+            self.factor = self._factor(share, self._exchange)
+            if self.heat is not None:
+                self.heat.update_conductance(self._thermal())
+        power = np.zeros(share.n_owned)
+        row: Dict[str, float] = {}
+        if self.conduction is not None:
+            self.conduction.update_conductance(self._conductance(self.T))
+            self.conduction.solve()
+            power = self.eta * self.conduction.joule_power()
+            currents = self.conduction.electrode_currents()
+            row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
+            row.update({f"I_{k}": v for k, v in currents.items()})
+            row["joule_power"] = float(summed(self.comm, np.array([power.sum()]))[0])
+            row["solve_iterations"] = int(self.conduction.info["iterations"])
+        if self.heat is not None and dt:
+            self.T = self.heat.advance(dt, power)
+            self.time += dt
+            self.joule_energy += row.get("joule_power", 0.0) * dt
+        if self.heat is not None:
+            from mpi4py import MPI
+            n_all = self.comm.allreduce(int(self.T.size))
+            row["T_mean"] = float(summed(self.comm, np.array([self.T.sum()]))[0] / max(n_all, 1))
+            row["T_max"] = self.comm.allreduce(float(self.T.max()) if self.T.size else -np.inf, op=MPI.MAX)
+            row["heat_content"] = self.heat.heat_content(float(self.material.reference_temperature or 0.0))
+        row["elements"] = int(self.comm.allreduce(int(share.n_owned)))
+        return row
+
+    @property
+    def potential(self) -> np.ndarray:
+        """Potential [V] of the owned elements (``share.owned_ids`` order)."""
+        if self.conduction is None:
+            return np.zeros(self.share.n_owned if self.share else 0)
+        return self.conduction.potential[:self.share.n_owned]
+
+    def temperatures_by_id(self) -> Dict[int, float]:
+        return dict(zip(self.share.owned_ids.tolist(), self.T.tolist()))
