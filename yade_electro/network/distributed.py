@@ -111,7 +111,7 @@ class PartitionedConduction:
         self.values = self._values(values)
         comm = mpi_comm(comm)
         ex = GhostExchange(network, comm)
-        held = summed(comm, np.bincount(el[el >= 0], minlength=len(self.names)).astype(np.int64))
+        held = summed(comm, np.bincount(el[el >= 0], minlength=len(self.names)), np.int64)
         empty = [n for n, k in zip(self.names, held) if k == 0]
         if empty:
             raise BoundaryConditionError(f"electrode(s) {empty} hold no element on any rank: check their selection")

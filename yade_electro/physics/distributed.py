@@ -60,6 +60,15 @@ class Share:
     def owned_ids(self) -> np.ndarray:
         return self.network.owned_key
 
+    def conducting(self, keep) -> "Share":
+        """The share with only the edges ``keep`` (a mask): contacts that touch; the nodes stay."""
+        keep = np.asarray(keep, dtype=bool)
+        if self.graph is None or np.all(keep):
+            return self
+        net = self.network
+        graph = self.graph.with_edges(self.graph.edges[keep])
+        return Share(graph, LocalNetwork(net.owned_key, net.ghost_key, net.ghost_owner, graph.edges))
+
 
 def carve_share(graph: Optional[ContactGraph], owner, rank: int) -> Share:
     """The share of rank ``rank`` of a graph of the elements it has (the whole packing, or its
@@ -249,13 +258,16 @@ class DistributedElectroThermal:
         """One call on ``share`` (a new element set or edge set rebuilds the solves, else the
         values are refreshed in place): the potential, the Joule heat, and a heat step of
         ``dt`` [s] (None or 0: no heat step). Returns the totals of all ranks."""
-        same = (self.share is not None and share.network.edges.shape == self.share.network.edges.shape
-                and np.array_equal(share.network.owned_key, self.share.network.owned_key)
-                and np.array_equal(share.network.ghost_key, self.share.network.ghost_key)
-                and np.array_equal(share.network.edges, self.share.network.edges))
-        if not same:
-            if self.share is not None:
-                self._T_by_id = dict(zip(self.share.owned_ids.tolist(), self.T.tolist()))
+        if is_contact_law(self.law_name) and share.graph is not None:
+            share = share.conducting(self.law.factor(share.graph, share.graph.edges) > 0)
+        old = self.share
+        changed = (old is None or share.network.edges.shape != old.network.edges.shape
+                   or not np.array_equal(share.network.owned_key, old.network.owned_key)
+                   or not np.array_equal(share.network.ghost_key, old.network.ghost_key)
+                   or not np.array_equal(share.network.edges, old.network.edges))
+        if self.comm.allreduce(int(changed)):        # one rank's new structure is everyone's new setup
+            if old is not None:
+                self._T_by_id = dict(zip(old.owned_ids.tolist(), self.T.tolist()))
             self.prepare(share)
         else:
             self.share = share

@@ -60,10 +60,12 @@ def mpi_comm(comm=None):
     return comm.tompi4py() if hasattr(comm, "tompi4py") else comm
 
 
-def summed(comm, values) -> np.ndarray:
-    """The element-wise sum over the ranks of a float or int array (collective)."""
+def summed(comm, values, dtype=float) -> np.ndarray:
+    """The element-wise sum over the ranks of an array, as ``dtype`` (collective). The type is
+    forced: numpy's ``bincount`` of an empty array is int64 even with float weights, and a
+    rank with no elements must not send integers where the others send floats."""
     from mpi4py import MPI
-    v = np.ascontiguousarray(values)
+    v = np.ascontiguousarray(values, dtype=dtype)
     out = np.empty_like(v)
     comm.Allreduce(v, out, op=MPI.SUM)
     return out

@@ -29,7 +29,7 @@ import numpy as np
 from ..core.errors import BoundaryConditionError
 from ..core.materials import Material
 from ..physics.distributed import DISTRIBUTED_LAWS, DistributedElectroThermal, Exchange, Held, carve_share
-from .runtime import in_mpy_subdomain
+from .runtime import in_mpy_subdomain, mpy_subdomain
 from .scene import ensure_thermal_state, write_body_attribute
 
 __all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls",
@@ -152,7 +152,7 @@ class DistributedCalls:
 
     def _owner(self, graph) -> np.ndarray:
         if self.mode == "mpy":
-            subD = self.O.subD
+            subD = mpy_subdomain()
             owner = np.full(graph.n_nodes, -1, np.int64)
             owner[np.isin(graph.ids, np.asarray(list(subD.ids), np.int64))] = self.rank
             for k, mirrored in enumerate(subD.mirrorIntersections):
@@ -173,10 +173,22 @@ class DistributedCalls:
         known.update(zip(graph.ids[new].tolist(), owner[new].tolist()))
         return owner
 
+    def abort(self, exc: BaseException):
+        """End every rank after this one failed (the others would wait for it forever): the
+        error is printed, then MPI_Abort."""
+        import sys
+        import traceback
+        sys.stderr.write(f"yade-electro: rank {self.rank} of {self.size} failed; ending all ranks (MPI_Abort)\n")
+        traceback.print_exception(type(exc), exc, exc.__traceback__, file=sys.stderr)
+        sys.stderr.flush()
+        self.model.comm.Abort(1)
+
     def call(self) -> dict:
         """One call (collective): read, carve, advance, write back; returns the history row."""
         master = self.mode == "mpy" and self.rank == 0
-        if not master and self.reader.scene_replaced:      # yade.mpy sent the master's scene
+        if not master and (self.mode == "mpy" or self.reader.scene_replaced):
+            # yade.mpy erases and re-inserts mirrored bodies when it collides: what the reader
+            # counts to detect a change does not see that, so a full read each call
             self.reader.invalidate()
         graph = None if master else self.reader.read()
         share = carve_share(graph, self._owner(graph) if graph is not None else None, self.rank)

@@ -377,6 +377,8 @@ class EngineBase:
             self.error = exc
             log.error("yade-electro engine %r failed at iteration %d: %s: %s", self.label, int(self.O.iter),
                       type(exc).__name__, exc)
+            if self._distributed is not None:       # the other ranks wait in a collective call: end them all
+                self._distributed.abort(exc)
             raise
         self._save_state()
         return out

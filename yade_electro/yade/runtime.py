@@ -13,7 +13,7 @@ import os
 import sys
 import warnings
 
-__all__ = ["import_yade", "in_yade", "yade_python_dirs", "MPY_REFUSAL", "in_mpy_subdomain"]
+__all__ = ["import_yade", "in_yade", "yade_python_dirs", "MPY_REFUSAL", "in_mpy_subdomain", "mpy_subdomain"]
 
 #: Directories tried first, in order; the double-precision build is the default ``yade``.
 PREFERRED_DIRS = (
@@ -93,11 +93,17 @@ MPY_REFUSAL = ("engine {label!r}: this scene is a subdomain of yade.mpy's decomp
                "the master's merged scene after mpy.mpirun(..., withMerge=True)")
 
 
-def in_mpy_subdomain() -> bool:
-    """True when yade.mpy has split the scene into subdomains (it sets ``O.subD`` on its own
-    Omega handle when ``mpirun`` starts; plain ``mpiexec`` runs without mpirun do not)."""
+def mpy_subdomain():
+    """yade.mpy's Subdomain of this rank once it has split the scene (it sets ``O.subD`` on its
+    own Omega handle when ``mpirun`` starts), else None."""
     mpy = sys.modules.get("yade.mpy")
-    return mpy is not None and getattr(getattr(mpy, "O", None), "subD", None) is not None
+    return None if mpy is None else getattr(getattr(mpy, "O", None), "subD", None)
+
+
+def in_mpy_subdomain() -> bool:
+    """True when yade.mpy has split the scene into subdomains (plain ``mpiexec`` runs without
+    mpirun do not)."""
+    return mpy_subdomain() is not None
 
 
 # =========================================================================================
