@@ -139,17 +139,6 @@ def test_petsc_two_ranks_standalone(tmp_path):
     assert rows[0]["R"] == rows[1]["R"]                    # every rank got the same solution
 
 
-def test_mpi_rod_case_on_two_ranks_in_yade(yade_exe):
-    res = _mpiexec(yade_exe + ["-n", "-x", os.path.join(ROOT, "cases", "mpi_rod.py"), "--n", "2000"], 2)
-    assert res.returncode == 0, (res.stdout[-2000:], res.stderr[-3000:])
-    rows = _json_rows(res.stdout)
-    assert len(rows) == 1                                  # rank 0 prints
-    row = rows[0]
-    assert row["case"] == "mpi_rod" and row["ranks"] == 2 and row["ranks_agree"]
-    assert row["n"] > 1500 and row["solvers"] == ["petsc", "cg-deflated"]
-    assert row["max_potential_diff_V"] < 1e-8 and row["R_rel_diff"] < 1e-8
-
-
 MPY_SCRIPT = textwrap.dedent("""
     from yade import mpy as mp
     import numpy as np

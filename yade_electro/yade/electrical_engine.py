@@ -279,16 +279,25 @@ class ElectricalEngine(EngineBase):
 
     @property
     def equivalent_resistance(self) -> float:
-        """R_eq [ohm] between the ``measure`` electrodes at the last solve (network property)."""
+        """R_eq [ohm] between the ``measure`` electrodes at the last solve (network property;
+        distributed: between the first two electrodes, the same on every rank)."""
+        if self._distributed is not None:
+            return float(self.history.rows[-1]["R_eq"]) if len(self.history) else float("nan")
         return self.model.equivalent_resistance
 
     @property
     def body_ids(self) -> np.ndarray:
+        """Ids of the elements (distributed: this rank's own)."""
+        if self._distributed is not None:
+            share = self._distributed.model.share
+            return share.owned_ids if share is not None else np.zeros(0, np.int64)
         return self.model.bond_graph.ids
 
     @property
     def potential(self) -> np.ndarray:
         """Potential [V] of each element, in ``body_ids`` order."""
+        if self._distributed is not None:
+            return self._distributed.model.potential
         return self.solution.potential[:self.model.n_elements]
 
     @property
@@ -305,6 +314,10 @@ class ElectricalEngine(EngineBase):
 
     @property
     def electrode_currents(self) -> Dict[str, float]:
+        """Current [A] fed into the network by each electrode (distributed: summed over the ranks)."""
+        if self._distributed is not None:
+            row = self.history.rows[-1] if len(self.history) else {}
+            return {s.name: float(row.get(f"I_{s.name}", float("nan"))) for s in self.model.specs}
         return dict(self.solution.electrode_current)
 
 

@@ -471,16 +471,20 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
 
     @property
     def temperature(self) -> np.ndarray:
-        """Temperature [K] of each element, in ``body_ids`` order."""
+        """Temperature [K] of each element, in ``body_ids`` order (distributed: this rank's own)."""
+        if self._distributed is not None:
+            return self._distributed.model.T
         return self.coupled.temperature
 
     @property
     def body_ids(self) -> np.ndarray:
+        if self._distributed is not None:
+            return ElectricalEngine.body_ids.fget(self)
         return self.coupled.network.graph.ids
 
     @property
     def temperature_by_id(self) -> Dict[int, float]:
-        return dict(zip(self.body_ids.tolist(), self.coupled.temperature.tolist()))
+        return dict(zip(self.body_ids.tolist(), self.temperature.tolist()))
 
     def set_temperatures(self, temperatures: Dict[int, float]):
         """Give chosen spheres a temperature [K] at the next call, before its step:

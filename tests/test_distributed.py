@@ -1,0 +1,62 @@
+"""Distributed engines on real YADE under a real mpiexec: cases/distributed.py with 3 ranks
+(plain mpiexec: 3 ranks own slabs; yade.mpy: a master and 2 workers), each against a serial
+reference; and the errors a distributed run gives when the engine is built."""
+import json
+import os
+import subprocess
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+
+
+def _mpiexec(args, n, timeout=900):
+    env = dict(os.environ, **MPI_ENV)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, env.get("PYTHONPATH")) if p)
+    cmd = ["mpiexec", "--oversubscribe", "-n", str(n)] + list(args)
+    return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+
+
+def test_distributed_case_matches_serial_with_two_workers(yade_exe):
+    res = _mpiexec(yade_exe + ["-n", "-x", os.path.join(ROOT, "cases", "distributed.py"), "--quick"], 3)
+    rows = [json.loads(line) for line in res.stdout.splitlines() if line.startswith('{"ranks"')]
+    assert res.returncode == 0 and len(rows) == 1, res.stdout[-2000:] + res.stderr[-4000:]
+    out = rows[0]
+    assert out["workers"] == {"plain_mpiexec": 3, "yade_mpy": 2}
+    for case in ("rod", "bed", "mpy"):
+        assert out[case]["max_rel_diff"] < 1e-8, (case, out[case])
+    assert out["rod"]["elements"] > 900 and out["rod"]["owned"] < out["rod"]["elements"]
+    assert out["bed"]["T_rise_K"] > 1.0 and out["rod"]["T_rise_K"] > 10.0
+    assert out["mpy"]["calls"] >= 5 and out["max_rel_diff"] < 1e-8
+
+
+BAD_SCRIPT = """
+import numpy as np
+from yade import pack
+from yade_electro.yade import ElectricalEngine, Electrode, Material
+from yade_electro.core.errors import BoundaryConditionError
+for i in range(4):
+    for j in range(4):
+        for k in range(8):
+            O.bodies.append(sphere((i, j, k), 0.51))
+ids = np.arange(len(O.bodies))
+z = np.array([b.state.pos[2] for b in O.bodies])
+from yade_electro.yade import Reader
+kw = dict(material=Material(resistivity=1e-6), reader=Reader(bonds="contacts"), law="contact", solver="petsc")
+try:
+    ElectricalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], current=1.0),
+                                 Electrode("b", select=ids[z > 6.5], potential=0.0)], **kw)
+except BoundaryConditionError as exc:
+    print("REFUSED", exc, flush=True)
+"""
+
+
+def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
+    script = tmp_path / "bad.py"
+    script.write_text(BAD_SCRIPT)
+    res = _mpiexec(yade_exe + ["-n", "-x", str(script)], 2, timeout=300)
+    refused = [line for line in res.stdout.splitlines() if line.startswith("REFUSED")]
+    assert res.returncode == 0 and len(refused) == 2, res.stdout[-2000:] + res.stderr[-3000:]
+    assert "current-driven electrodes" in refused[0] and "solver='petsc'" in refused[0]
