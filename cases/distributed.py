@@ -233,6 +233,75 @@ def mpy_case(n=200, calls=8, period=100):
             "wall_s": wall, "max_rel_diff": max(d_R, d_I, d_phi)}
 
 
+# -- memory -------------------------------------------------------------------------------
+def _vm(key: str) -> float:
+    """A line of /proc/self/status in bytes (VmRSS, VmHWM)."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith(key + ":"):
+                return float(line.split()[1]) * 1024.0
+    return float("nan")
+
+
+def _reset_peak():
+    """Make VmHWM the current RSS (Linux >= 4.0: writing 5 to clear_refs)."""
+    with open("/proc/self/clear_refs", "w") as f:
+        f.write("5")
+
+
+def engine_memory(n: int, solver: str, calls: int = 2) -> dict:
+    """Peak RSS growth [bytes] of an engine built on a bed of about ``n`` touching spheres (no
+    mechanics: the scene is read as it is) and called ``calls`` times."""
+    yade = import_yade()
+    O = yade.Omega()
+    ids, x, r = build_bed(n, gravity=0.0)
+    from yade import pack
+    del pack
+    for b in O.bodies:                       # touching neighbours: grow the spheres by 1 %
+        if isinstance(b.shape, yade.Sphere):
+            b.shape.radius *= 1.01
+    import gc
+    gc.collect()
+    _reset_peak()
+    rss0 = _vm("VmRSS")
+    t = time.perf_counter()
+    eng = bed_engine(ids, x, r * 1.01, solver, "mem_" + solver.replace("-", "_"), 1)
+    for _ in range(calls):
+        eng.step()
+    wall = time.perf_counter() - t
+    row = eng.history.rows[-1]
+    return {"spheres": int(ids.size), "growth_bytes": _vm("VmHWM") - rss0, "rss_before_bytes": rss0,
+            "wall_s": wall, "R_eq": row["R_eq"], "solver": solver}
+
+
+def mem_case(n: int) -> dict:
+    """The serial engine in a process of its own (started by rank 0, without the MPI
+    environment), then the distributed one on every rank; mem_ratio over the serial growth."""
+    import subprocess
+    comm = _comm()
+    serial = None
+    if comm.Get_rank() == 0:
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("OMPI_", "PMIX", "PMI_", "OPAL_"))}
+        exe = [sys.executable] if "yade" in os.path.basename(sys.executable) else ["yade-electro"]
+        cmd = exe + ["-n", "-x", os.path.abspath(_SCRIPT), "--cases", "mem-serial", "--mem", str(n)]
+        res = subprocess.run(cmd, env=env, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+        rows = [json.loads(line) for line in res.stdout.splitlines() if line.startswith('{"mem_serial"')]
+        if res.returncode != 0 or not rows:
+            raise RuntimeError(f"the serial memory run failed: {res.stderr[-2000:]}")
+        serial = rows[0]["mem_serial"]
+    comm.Barrier()
+    mine = engine_memory(n, "petsc")
+    every = comm.gather(mine, root=0)
+    if comm.Get_rank() != 0:
+        return {}
+    worst = max(e["growth_bytes"] for e in every)
+    return {"spheres": mine["spheres"], "serial_growth_MB": serial["growth_bytes"] / 1e6,
+            "rank_growth_MB": [e["growth_bytes"] / 1e6 for e in every],
+            "mem_ratio": worst / serial["growth_bytes"], "R_rel_diff": abs(mine["R_eq"] - serial["R_eq"]) / serial["R_eq"],
+            "serial_wall_s": serial["wall_s"], "rank_wall_s": [e["wall_s"] for e in every],
+            "note": "the engines' own growth of the peak RSS; YADE's scene (every rank's in plain mpiexec) left out"}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", default="rod,bed,mpy", help="comma-separated: rod, bed, mpy, mem")
@@ -246,12 +315,20 @@ def main(argv=None):
     n_rod, n_bed = (1000, 200) if args.quick else (args.n_rod, args.n_bed)
     comm = _comm()
     out = {"ranks": comm.Get_size()}
+    if "mem-serial" in cases:               # the serial half of the memory case, in its own process
+        print(json.dumps({"mem_serial": engine_memory(args.mem, "cg-deflated")}), flush=True)
+        return None
     if "rod" in cases:
         _say(f"rod: {n_rod} elements")
         out["rod"] = rod_case(n_rod, cache_dir=args.cache_dir)
     if "bed" in cases:
         _say(f"bed: about {n_bed} spheres")
         out["bed"] = bed_case(n_bed)
+    if "mem" in cases:
+        _say(f"memory: about {args.mem} spheres")
+        out["mem"] = mem_case(args.mem)
+        if comm.Get_rank() == 0:
+            out["mem_ratio"] = out["mem"]["mem_ratio"]
     if "mpy" in cases:                      # last: yade.mpy splits the scene for good
         _say(f"mpy: about {n_bed} spheres")
         res = mpy_case(n_bed)
