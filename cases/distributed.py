@@ -14,8 +14,11 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     heated between its two ends, one end at 293 K, Crank-Nicolson, serial engine beside the
     distributed one as for the rod (plain mpiexec: the mechanics are every rank's).
 ``pin``
-    Not run: the pin torsion test's electrodes are surface electrodes of the 'voronoi' law,
-    which a distributed run does not do yet (its tessellation is global); see the note.
+    The pin torsion test (pin_torsion's pin, rig and kept calibration), twisted 20 times the
+    paper's rate until 0.12 rad or separation, with its continuum-law engine (end element
+    layers; its other engine, the 'voronoi' law with surface electrodes, is not distributed:
+    the tessellation is global) serial and distributed side by side: bonds break, each rank's
+    share loses edges, the solves are rebuilt collectively. Plain mpiexec.
 ``mpy``
     The same bed inside YADE's MPI mode (``yade.mpy``, ``mp.mpirun``): rank 0 is YADE's master
     (owns no sphere), the other ranks its workers (x slabs). yade.mpy's mechanics do not follow
@@ -26,10 +29,12 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
 ``max_rel_diff``: the worst over the cases of R_eq, electrode currents, potentials (over the
 applied voltage) and temperature rises (over the largest rise).
 
-Memory (``--mem N``): a bed of N spheres, the engine's own growth of the peak RSS (VmHWM reset
-before it is built; the YADE scene is every rank's in plain mpiexec, so it is left out) in a
-serial run on rank 0 and in the distributed run on every rank: ``mem_ratio`` = the largest
-rank's growth over the serial one.
+Memory (``--cases mem --mem N``): a bed of about N spheres (``--mem 114000``: 215,407), the
+engine's own growth of the peak RSS (VmHWM reset before it is built; PETSc's and MPI's
+libraries, about 80 MB per process, loaded before and reported apart) in a serial process (started
+by rank 0) and on every rank of the distributed run: ``mem_ratio`` = the largest rank's growth over
+the serial one. ``process_peak_ratio`` compares whole processes (in plain mpiexec every rank
+holds YADE's whole scene).
 
 Run
 ---
@@ -128,6 +133,57 @@ def rod_case(n=3000, calls=5, cache_dir=None):
             temperature=T0, integrator=Integrator(theta="backward-euler", dt=1e-3), solver=solver, iterPeriod=1,
             label=label, output=Output(write_back=None))
     return _pair(make, calls, 1)
+
+
+# -- the pin ---------------------------------------------------------------------------------
+def pin_case(n=1000, rate_factor=20.0, every=100, theta_max=0.12, cache_dir=None):
+    """The pin torsion test (pin_torsion's pin and rig, its kept calibration for ``n``), twisted
+    ``rate_factor`` times faster than the paper until ``theta_max`` or separation, with the
+    continuum law's engine (end element layers) serial and distributed side by side: bonds
+    break, the share's edges change, the solves are rebuilt on every rank."""
+    import math
+    from pin_torsion import RAMP_ANGLE, RESISTIVITY, build_pin, load_calibration, paper_rate, pin_electrodes
+    from yade_electro.yade import ElectricalEngine, Material, Output, Reader, electrodes_from_dict
+    yade = import_yade()
+    O = yade.Omega()
+    cal = load_calibration(n, 1, cache_dir=cache_dir, progress=_say)
+    rate = paper_rate() * rate_factor
+    pin = build_pin(n, 1, cal["young"], cal["strength"], rate=rate, ramp_time=2 * RAMP_ANGLE / rate,
+                    cache_dir=cache_dir)
+    electrodes, _ = pin_electrodes(pin, "continuum")
+
+    def make(solver, label):
+        return ElectricalEngine(material=Material(resistivity=RESISTIVITY), boundaries=electrodes_from_dict(electrodes),
+                                law="continuum", reader=Reader(bond_check="flags"), output=Output(write_back=None),
+                                solver=solver, iterPeriod=every, label=label)
+    ser, dis = make("direct", "pin_ser"), make("petsc", "pin_dis")
+    O.engines = O.engines + [ser.runner, dis.runner]
+    rig = pin["rig"]
+    t = time.perf_counter()
+    while rig.theta < theta_max and math.isfinite(ser.equivalent_resistance if len(ser.history) else 0.0):
+        O.run(10 * every, True)
+    wall = time.perf_counter() - t
+    comm = _comm()
+    d_R, finite = 0.0, 0
+    for rs, rd in zip(ser.history.rows, dis.history.rows):
+        if math.isfinite(rs["R_eq"]) != math.isfinite(rd["R_eq"]):
+            d_R = math.inf                          # one separated, the other not
+        elif math.isfinite(rs["R_eq"]):
+            d_R = max(d_R, abs(rd["R_eq"] - rs["R_eq"]) / abs(rs["R_eq"]))
+            finite += 1
+    last_finite = [r for r in ser.history.rows if math.isfinite(r["R_eq"])]
+    own = dis.body_ids
+    phi_s = ser.potential_by_id
+    d_phi = _worst(comm, max((abs(p - phi_s[i]) for i, p in zip(own.tolist(), dis.potential.tolist())), default=0.0))
+    O.engines = [e for e in O.engines if getattr(e, "label", "") not in ("pin_ser", "pin_dis")]
+    rig.remove()
+    pin["strength_check"].remove()
+    R0 = ser.history.rows[0]["R_eq"]
+    return {"calls": len(dis.history.rows), "theta": float(rig.theta), "R_eq_first": R0,
+            "R_ratio_last_finite": last_finite[-1]["R_eq"] / R0 if last_finite else None,
+            "separated": not math.isfinite(ser.history.rows[-1]["R_eq"]), "R_rel_diff": d_R,
+            "potential_diff_over_V": d_phi, "compared_calls": finite, "elements": int(len(pin["ids"])),
+            "wall_s": wall, "max_rel_diff": max(d_R, d_phi)}
 
 
 # -- the bed --------------------------------------------------------------------------------
@@ -261,6 +317,11 @@ def engine_memory(n: int, solver: str, calls: int = 2) -> dict:
         if isinstance(b.shape, yade.Sphere):
             b.shape.radius *= 1.01
     import gc
+    lib = _vm("VmRSS")
+    if solver.startswith("petsc"):           # PETSc's and MPI's libraries: loaded once per process
+        from yade_electro.solvers.petsc import import_petsc
+        import_petsc()
+    lib = _vm("VmRSS") - lib
     gc.collect()
     _reset_peak()
     rss0 = _vm("VmRSS")
@@ -271,6 +332,7 @@ def engine_memory(n: int, solver: str, calls: int = 2) -> dict:
     wall = time.perf_counter() - t
     row = eng.history.rows[-1]
     return {"spheres": int(ids.size), "growth_bytes": _vm("VmHWM") - rss0, "rss_before_bytes": rss0,
+            "libraries_bytes": lib, "process_peak_bytes": _vm("VmHWM"),
             "wall_s": wall, "R_eq": row["R_eq"], "solver": solver}
 
 
@@ -297,17 +359,22 @@ def mem_case(n: int) -> dict:
     worst = max(e["growth_bytes"] for e in every)
     return {"spheres": mine["spheres"], "serial_growth_MB": serial["growth_bytes"] / 1e6,
             "rank_growth_MB": [e["growth_bytes"] / 1e6 for e in every],
-            "mem_ratio": worst / serial["growth_bytes"], "R_rel_diff": abs(mine["R_eq"] - serial["R_eq"]) / serial["R_eq"],
+            "mem_ratio": worst / serial["growth_bytes"],
+            "libraries_MB": max(e["libraries_bytes"] for e in every) / 1e6,
+            "process_peak_ratio": max(e["process_peak_bytes"] for e in every) / serial["process_peak_bytes"],
+            "R_rel_diff": abs(mine["R_eq"] - serial["R_eq"]) / serial["R_eq"],
             "serial_wall_s": serial["wall_s"], "rank_wall_s": [e["wall_s"] for e in every],
-            "note": "the engines' own growth of the peak RSS; YADE's scene (every rank's in plain mpiexec) left out"}
+            "note": "mem_ratio: the engines' own growth of the peak RSS, PETSc's libraries loaded before (libraries_MB); "
+                    "process_peak_ratio: whole processes, YADE's scene (every rank's in plain mpiexec) included"}
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="rod,bed,mpy", help="comma-separated: rod, bed, mpy, mem")
+    ap.add_argument("--cases", default="rod,pin,bed,mpy", help="comma-separated: rod, pin, bed, mpy, mem")
     ap.add_argument("--quick", action="store_true", help="small sizes (the CI test)")
     ap.add_argument("--n-rod", type=int, default=3000)
     ap.add_argument("--n-bed", type=int, default=400)
+    ap.add_argument("--n-pin", type=int, default=5000)
     ap.add_argument("--mem", type=int, default=200000, help="spheres of the memory case")
     ap.add_argument("--cache-dir", default=None)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
@@ -321,6 +388,10 @@ def main(argv=None):
     if "rod" in cases:
         _say(f"rod: {n_rod} elements")
         out["rod"] = rod_case(n_rod, cache_dir=args.cache_dir)
+    if "pin" in cases:
+        n_pin = 1000 if args.quick else args.n_pin
+        _say(f"pin: {n_pin} elements")
+        out["pin"] = pin_case(n_pin, cache_dir=args.cache_dir)
     if "bed" in cases:
         _say(f"bed: about {n_bed} spheres")
         out["bed"] = bed_case(n_bed)

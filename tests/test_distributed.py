@@ -1,6 +1,7 @@
 """Distributed engines on real YADE under a real mpiexec: cases/distributed.py with 3 ranks
-(plain mpiexec: 3 ranks own slabs; yade.mpy: a master and 2 workers), each against a serial
-reference; and the errors a distributed run gives when the engine is built."""
+(plain mpiexec: 3 ranks own slabs; yade.mpy: a master and 2 workers), each case against a
+serial reference (the rod, the pin torsion test with bonds breaking, the bed; the bed in
+yade.mpy); and the errors a distributed run gives when the engine is built."""
 import json
 import os
 import subprocess
@@ -24,11 +25,12 @@ def test_distributed_case_matches_serial_with_two_workers(yade_exe):
     assert res.returncode == 0 and len(rows) == 1, res.stdout[-2000:] + res.stderr[-4000:]
     out = rows[0]
     assert out["workers"] == {"plain_mpiexec": 3, "yade_mpy": 2}
-    for case in ("rod", "bed", "mpy"):
+    for case in ("rod", "pin", "bed", "mpy"):
         assert out[case]["max_rel_diff"] < 1e-8, (case, out[case])
     assert out["rod"]["elements"] > 900 and out["rod"]["owned"] < out["rod"]["elements"]
     assert out["bed"]["T_rise_K"] > 1.0 and out["rod"]["T_rise_K"] > 10.0
     assert out["mpy"]["calls"] >= 5 and out["max_rel_diff"] < 1e-8
+    assert out["pin"]["compared_calls"] >= 5 and out["pin"]["R_ratio_last_finite"] > 1.05   # bonds broke
 
 
 BAD_SCRIPT = """
