@@ -117,9 +117,12 @@ class PartitionedConduction:
             raise BoundaryConditionError(f"electrode(s) {empty} hold no element on any rank: check their selection")
         reach = spread_over_parts(network, ex, (el >= 0).astype(np.int64), op="max")
         self.floating = reach == 0
+        part = spread_over_parts(network, ex, network.owned_key, op="min")
+        # the parts each electrode touches (its elements' labels, from every rank)
+        touched = comm.allgather([np.unique(part[el == k]) for k in range(len(self.names))])
+        self._parts_of = [set(np.concatenate([t[k] for t in touched]).tolist()) for k in range(len(self.names))]
         n_float = int(comm.allreduce(int(np.count_nonzero(self.floating))))
         if n_float:
-            part = spread_over_parts(network, ex, network.owned_key, op="min")
             heads = int(comm.allreduce(int(np.count_nonzero(self.floating & (part == network.owned_key)))))
             if comm.Get_rank() == 0:
                 warnings.warn(floating_message(n_float, heads, "electrode", "a potential of 0 V"), stacklevel=2)
@@ -186,12 +189,15 @@ class PartitionedConduction:
         return dict(zip(self.names, total.tolist()))
 
     def equivalent_resistance(self, a: Optional[str] = None, b: Optional[str] = None) -> float:
-        """(V_a - V_b) / I_a between two electrodes [ohm] (the first two by default)."""
+        """(V_a - V_b) / I_a between two electrodes [ohm] (the first two by default); inf when
+        no connected part holds elements of both."""
         a = self.names[0] if a is None else a
         b = self.names[1] if b is None else b
-        va, vb = self.values[self.names.index(a)], self.values[self.names.index(b)]
+        ka, kb = self.names.index(a), self.names.index(b)
+        if not (self._parts_of[ka] & self._parts_of[kb]):
+            return float("inf")                 # no path joins them (the serial rule: never a huge finite R)
         i = self.electrode_currents()[a]
-        return float((va - vb) / i) if i != 0 else float("inf")
+        return float((self.values[ka] - self.values[kb]) / i) if i != 0 else float("inf")
 
     def joule_power(self) -> np.ndarray:
         """Joule heat [W] of each owned node: each edge's c dV^2 shared half and half by its ends."""
