@@ -282,7 +282,7 @@ class ElectricalEngine(EngineBase):
         """R_eq [ohm] between the ``measure`` electrodes at the last solve (network property;
         distributed: between the first two electrodes, the same on every rank)."""
         if self._distributed is not None:
-            return float(self.history.rows[-1]["R_eq"]) if len(self.history) else float("nan")
+            return float(self.history.rows[-1].get("R_eq", float("nan"))) if len(self.history) else float("nan")
         return self.model.equivalent_resistance
 
     @property

@@ -87,10 +87,9 @@ def import_yade():
                       % (INSTALL_HINT, sys.executable, "\n  ".join(errors)))
 
 
-MPY_REFUSAL = ("engine {label!r}: this scene is a subdomain of yade.mpy's decomposition (O.subD is set): the "
-               "engine would see only this rank's bodies and give wrong results. Run the whole scene on every "
-               "rank (mpiexec without mpy.mpirun) with solver='petsc' to share the solve, or call the engine on "
-               "the master's merged scene after mpy.mpirun(..., withMerge=True)")
+MPY_REFUSAL = ("engine {label!r}: this scene is a subdomain of yade.mpy's decomposition (O.subD is set) and the "
+               "engine was built for a serial solve: it would see only this rank's bodies. Build it with "
+               "solver='petsc' (before mp.mpirun): it then runs distributed on yade.mpy's subdomains")
 
 
 def mpy_subdomain():
