@@ -19,6 +19,9 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     layers; its other engine, the 'voronoi' law with surface electrodes, is not distributed:
     the tessellation is global) serial and distributed side by side: bonds break, each rank's
     share loses edges, the solves are rebuilt collectively. Plain mpiexec.
+``heat``
+    Heat only on the bed (HeatEngine, made distributed by ``Integrator(solver='petsc')``): one end
+    at 350 K, convection to 280 K at the other, forward Euler with sub-steps. Plain mpiexec.
 ``mpy``
     The same bed inside YADE's MPI mode (``yade.mpy``, ``mp.mpirun``): rank 0 is YADE's master
     (owns no sphere), the other ranks its workers (x slabs). yade.mpy's mechanics do not follow
@@ -82,7 +85,7 @@ def _worst(comm, x) -> float:
     return max(comm.allgather(float(x)))
 
 
-def _pair(make, calls, steps_per_call):
+def _pair(make, calls, steps_per_call, electrical=True):
     """Run the serial engine (solver='direct') and the distributed one (solver='petsc') side by
     side on the scene, ``calls`` calls; returns both and the worst relative differences."""
     yade = import_yade()
@@ -95,22 +98,25 @@ def _pair(make, calls, steps_per_call):
     comm = _comm()
     model = dis._distributed.model
     own = model.share.owned_ids
-    d_R, d_I = 0.0, 0.0
+    d_R, d_I, d_phi = 0.0, 0.0, 0.0
     for rs, rd in zip(ser.history.rows, dis.history.rows):
-        d_R = max(d_R, abs(rd["R_eq"] - rs["R_eq"]) / abs(rs["R_eq"]))
-        d_I = max(d_I, abs(rd["joule_power"] - rs["joule_power"]) / abs(rs["joule_power"]))
+        if electrical:
+            d_R = max(d_R, abs(rd["R_eq"] - rs["R_eq"]) / abs(rs["R_eq"]))
+            d_I = max(d_I, abs(rd["joule_power"] - rs["joule_power"]) / abs(rs["joule_power"]))
     Ts = ser.temperature_by_id
     Td = model.temperatures_by_id()
     rise = max(abs(v - T0) for v in Ts.values())
     d_T = _worst(comm, max((abs(Td[i] - Ts[i]) for i in own.tolist()), default=0.0)) / rise
-    phi_s = ser.potential_by_id
-    d_phi = _worst(comm, max((abs(p - phi_s[i]) for i, p in zip(own.tolist(), model.potential.tolist())),
-                             default=0.0))
+    if electrical:
+        phi_s = ser.potential_by_id
+        d_phi = _worst(comm, max((abs(p - phi_s[i]) for i, p in zip(own.tolist(), model.potential.tolist())),
+                                 default=0.0))
     O.engines = [e for e in O.engines if getattr(e, "label", "") not in ("ser", "dis")]
-    out = {"calls": len(dis.history.rows), "R_eq": dis.history.rows[-1]["R_eq"], "R_rel_diff": d_R,
+    out = {"calls": len(dis.history.rows), "R_eq": dis.history.rows[-1].get("R_eq"), "R_rel_diff": d_R,
            "joule_rel_diff": d_I, "potential_diff_over_V": d_phi, "T_rise_K": rise, "T_rel_diff": d_T,
            "owned": int(own.size), "elements": int(dis.history.rows[-1]["elements"]), "wall_s": wall,
-           "solve_iterations": dis.history.rows[-1].get("solve_iterations")}
+           "solve_iterations": dis.history.rows[-1].get("solve_iterations"),
+           "substeps_serial_distributed": [ser.history.rows[-1].get("n_substeps"), dis.history.rows[-1].get("n_substeps")]}
     out["max_rel_diff"] = max(d_R, d_I, d_phi, d_T)
     return out
 
@@ -229,6 +235,24 @@ def bed_engine(ids, x, r, solver, label, period, beta=2e-3):
                     FixedTemperature("cold", nodes=left, temperature=T0)],
         temperature=T0, integrator=Integrator(theta="crank-nicolson", dt=0.5), solver=solver, iterPeriod=period,
         label=label, output=Output(write_back=None))
+
+
+def heat_case(n=200, calls=8, period=100):
+    """Heat only on the bed (HeatEngine): one end held at 350 K, convection to 280 K at the other,
+    forward Euler with sub-steps (the call's step is far above the stable one); serial beside
+    distributed (``Integrator(solver='petsc')`` makes a heat engine distributed)."""
+    from yade_electro.yade import Convection, FixedTemperature, HeatEngine, Integrator, Material, Reader
+    ids, x, r = build_bed(n)
+    mat = Material(density=2600.0, specific_heat=800.0, conductivity=2.0)
+    left, right = ids[x < x.min() + r], ids[x > x.max() - r]
+
+    def make(solver, label):
+        return HeatEngine(material=mat, law="contact", reader=Reader(bonds="contacts"),
+                          boundaries=[FixedTemperature("hot", nodes=left, temperature=350.0),
+                                      Convection("air", nodes=right, h=50.0, t_inf=280.0, area=3e-6)],
+                          temperature=T0, integrator=Integrator(theta="explicit", dt=200.0, solver=solver),
+                          iterPeriod=period, label=label)
+    return _pair(make, calls, period, electrical=False)
 
 
 def bed_case(n=200, calls=8, period=100):
@@ -370,7 +394,7 @@ def mem_case(n: int) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="rod,pin,bed,mpy", help="comma-separated: rod, pin, bed, mpy, mem")
+    ap.add_argument("--cases", default="rod,pin,bed,heat,mpy", help="comma-separated: rod, pin, bed, heat, mpy, mem")
     ap.add_argument("--quick", action="store_true", help="small sizes (the CI test)")
     ap.add_argument("--n-rod", type=int, default=3000)
     ap.add_argument("--n-bed", type=int, default=400)
@@ -382,6 +406,9 @@ def main(argv=None):
     n_rod, n_bed = (1000, 200) if args.quick else (args.n_rod, args.n_bed)
     comm = _comm()
     out = {"ranks": comm.Get_size()}
+    if "heat" in cases:
+        _say(f"heat: about {n_bed} spheres")
+        out["heat"] = heat_case(n_bed)
     if "mem-serial" in cases:               # the serial half of the memory case, in its own process
         print(json.dumps({"mem_serial": engine_memory(args.mem, "cg-deflated")}), flush=True)
         return None

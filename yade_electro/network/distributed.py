@@ -23,6 +23,7 @@ Units: S, V, A, W for conduction; W/K, J/K, K, W, s for heat.
 """
 from __future__ import annotations
 
+import math
 import warnings
 from typing import Mapping, Optional, Sequence
 
@@ -223,12 +224,15 @@ class PartitionedHeat:
     fixed : (n_owned,) float, NaN where free, the held temperature [K] elsewhere; optional
     h_area, t_inf : (n_owned,) convection h A [W/K] and ambient temperature [K]; optional
     theta : as :func:`~yade_electro.network.theta.theta_of` (default backward Euler)
+    safety, max_substeps : the explicit sub-steps' fraction of the stable step and their limit
     """
 
     def __init__(self, network: LocalNetwork, capacity, conductance, temperature, *, fixed=None, h_area=None,
                  t_inf=None, theta="backward-euler", comm=None, preconditioner: str = "deflation",
-                 rtol: float = 1e-12, pos=None, spacing: Optional[float] = None, options: Optional[dict] = None):
+                 rtol: float = 1e-12, pos=None, spacing: Optional[float] = None, options: Optional[dict] = None,
+                 safety: float = 0.9, max_substeps: int = 100000):
         n = network.n_owned
+        self.safety, self.max_substeps, self.substeps = float(safety), int(max_substeps), 0
         C = np.asarray(capacity, dtype=float)
         if C.shape != (n,) or not np.all(np.isfinite(C)) or np.any(C <= 0):
             raise ThermalError(f"heat capacities must be finite and > 0 (J/K), one per owned node ({n})")
@@ -283,39 +287,51 @@ class PartitionedHeat:
         return self._share.comm.allreduce(mine, op=MPI.MIN)
 
     def advance(self, dt: float, power=None) -> np.ndarray:
-        """One step of ``dt`` [s] with sources ``power`` [W] per owned node held over it; returns
+        """A step of ``dt`` [s] with sources ``power`` [W] per owned node held over it; returns
         the owned temperatures [K] (collective). The change dT of the free nodes solves
-        ``(C/dt + theta K_uu) dT = s - K T`` (no solve for theta = 0); forward Euler above its
-        bound raises, and a failed step leaves the state as it was."""
+        ``(C/dt + theta K_uu) dT = s - K T`` (no solve for theta = 0). For theta < 1/2 a step
+        above ``safety`` times the stable one is split into equal sub-steps, as serially
+        (:class:`~yade_electro.network.transient.HeatSolver`); ``substeps`` says how many. A
+        failed step leaves the state as it was."""
         if not (dt > 0 and np.isfinite(dt)):
             raise ThermalError(f"the time step must be finite and > 0 (s), got {dt}")
-        s, th = self._share, self.theta
         n = self.network.n_owned
         P = np.zeros(n) if power is None else np.asarray(power, dtype=float)
         if P.shape != (n,) or not np.all(np.isfinite(P)):
             raise ThermalError(f"sources must be finite (W), one per owned node ({n})")
-        if th < 0.5:
-            bound = self.stable_time_step() / (1.0 - 2.0 * th)
-            if dt > bound:
-                raise ThermalError(f"dt = {dt:.3e} s is above the stable step {bound:.3e} s of theta = {th:g}; "
-                                   "take smaller steps or theta >= 1/2")
-        rhs = self._free(self.h_area * self.t_inf + P - self.flow())
-        Cdt = self.capacity / dt
+        self.substeps = 1
+        if self.theta < 0.5:
+            largest = self.safety * self.stable_time_step() / (1.0 - 2.0 * self.theta)
+            if dt > largest:
+                self.substeps = int(math.ceil(dt / largest))
+                if self.substeps > self.max_substeps:
+                    raise ThermalError(f"dt = {dt:.3e} s needs {self.substeps} explicit sub-steps (stable step "
+                                       f"{largest:.3e} s), more than max_substeps = {self.max_substeps}; take "
+                                       "smaller steps or theta >= 1/2")
+        T = self.T
+        for _ in range(self.substeps):
+            T = self._step(T, dt / self.substeps, P)
+        self.T = T
+        self.time += dt
+        return T
+
+    def _step(self, T0, h, P) -> np.ndarray:
+        s, th = self._share, self.theta
+        rhs = self._free(self.h_area * self.t_inf + P - self.flow(T0))
+        Cdt = self.capacity / h
         if th == 0.0:
             dT = rhs / self._free(Cdt)
         else:
-            if self._dt != dt:                  # the step matrix for this dt and these conductances
+            if self._dt != h:                   # the step matrix for this step and these conductances
                 s.system.set_values(s.rows.values(th * self.conductance, th * self.h_area + Cdt), s.exchange)
             dT, self.info = s.system.solve(rhs, x0=self._dT)
             self._dT = dT
-        self._dt = dt
-        new = self._free(self.T) + dT
+        self._dt = h
+        new = self._free(T0) + dT
         if not np.all(np.isfinite(new)):
             raise ThermalError("the heat step gave non-finite temperatures; the state is kept")
-        T = self.T.copy()
+        T = T0.copy()
         T[s.rows.free_owned] = new
-        self.T = T
-        self.time += dt
         return T
 
     def heat_content(self, reference: float = 0.0) -> float:

@@ -122,7 +122,8 @@ class DistributedElectroThermal:
     electrodes : list of Held (potentials [V])
     fixed : list of Held (temperatures [K]); convection : list of Exchange
     temperature : float, initial temperature [K]; None: no heat (conduction only)
-    theta : the integrator's theta; eta : the share of the Joule power turned into heat
+    theta : the integrator's theta; eta : the share of the Joule power turned into heat;
+    safety, max_substeps : the explicit sub-steps (see PartitionedHeat)
     volume_fraction : float or None (the continuum model's from the bonds)
     preconditioner : of the partitioned solves ('deflation', 'hypre', 'gamg', 'jacobi')
     comm : mpi4py or petsc4py communicator (default all ranks)
@@ -131,8 +132,8 @@ class DistributedElectroThermal:
     def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
                  temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
-                 volume_fraction: Optional[float] = None, preconditioner: str = "deflation", rtol: float = 1e-10,
-                 comm=None):
+                 volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
+                 preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
             raise BoundaryConditionError(f"a distributed run computes the laws {', '.join(DISTRIBUTED_LAWS)}; law "
                                          f"{law!r} is not one of them (the 'voronoi' law's tessellation is global)")
@@ -141,6 +142,7 @@ class DistributedElectroThermal:
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
         self.temperature0 = temperature
         self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
+        self.safety, self.max_substeps = float(safety), int(max_substeps)
         self.preconditioner, self.rtol = preconditioner, float(rtol)
         self.comm = mpi_comm(comm)
         self._ids: Dict[str, np.ndarray] = {}
@@ -235,7 +237,8 @@ class DistributedElectroThermal:
                 hA[on] += item.h * area[on]
             self.heat = PartitionedHeat(net, self._capacity(share), self._thermal(), T,
                                         fixed=fixed, h_area=hA, t_inf=t_inf, theta=self.theta, comm=self.comm,
-                                        preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing)
+                                        preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing,
+                                        safety=self.safety, max_substeps=self.max_substeps)
             self.T = self.heat.T
 
     def _spacing(self, share: Share) -> float:
@@ -287,6 +290,7 @@ class DistributedElectroThermal:
             row["solve_iterations"] = int(self.conduction.info["iterations"])
         if self.heat is not None and dt:
             self.T = self.heat.advance(dt, power)
+            row["n_substeps"] = int(self.heat.substeps)
             self.time += dt
             self.joule_energy += row.get("joule_power", 0.0) * dt
         if self.heat is not None:

@@ -117,8 +117,8 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
     return DistributedElectroThermal(material, law, law_params, electrodes=held, fixed=fixed, convection=convection,
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
-                                     volume_fraction=h.get("volume_fraction"),
-                                     preconditioner=PETSC_SOLVERS[solver])
+                                     volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
+                                     max_substeps=h.get("max_substeps", 100000), preconditioner=PETSC_SOLVERS[solver])
 
 
 class DistributedCalls:

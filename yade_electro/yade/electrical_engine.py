@@ -222,7 +222,7 @@ class ElectricalEngine(EngineBase):
     def _distributed_calls(self, graph):
         ids = {name: graph.ids[m.nodes(graph)] for name, m in self.model.memberships.items()
                if any(s.name == name and s.surface is None and not s.wall for s in self.model.specs)}
-        model = distributed_model(solver=self._options["solver"], resistivity=self._resistivity,
+        model = distributed_model(solver=self._distributed_solver(), resistivity=self._resistivity,
                                   materials=self._materials_config, law=self._options["law"],
                                   law_params=self._law_params, electrodes=self.model.specs, electrode_ids=ids,
                                   walls=self._declared_walls)

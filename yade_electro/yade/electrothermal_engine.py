@@ -365,8 +365,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         vf = c.volume_fraction if not callable(c.volume_fraction) else None
         heat = dict(density=t["density"], specific_heat=t["specific_heat"], conductivity=t["conductivity"],
                     temperature=t["temperature"], beta=t["beta"], eta=t["eta"], theta=t["theta"],
-                    reference_temperature=t["coupled_options"].get("reference_temperature"), volume_fraction=vf)
-        model = distributed_model(solver=self._options["solver"], resistivity=self._resistivity,
+                    reference_temperature=t["coupled_options"].get("reference_temperature"), volume_fraction=vf,
+                    safety=c.heat_options["safety"], max_substeps=c.heat_options["max_substeps"])
+        model = distributed_model(solver=self._distributed_solver(), resistivity=self._resistivity,
                                   materials=self._materials_config, law=self._options["law"] or "continuum",
                                   law_params=self._law_params, electrodes=specs, electrode_ids=ids, heat=heat,
                                   conditions=self._heat_conditions, condition_ids=cond_ids,

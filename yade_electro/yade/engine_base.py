@@ -247,7 +247,7 @@ class EngineBase:
         graph = self.reader.read()                  # no spheres: GraphError here, in the script
         check_write_back(self.write_back, self.reader.bodies)
         self._distributed = None
-        if distributed_requested(self._options.get("solver")):
+        if distributed_requested(self._distributed_solver()):
             if self._resume is not None:
                 raise RuntimeError(f"engine {self.label!r}: a distributed run does not continue a saved one yet")
             self._distributed = self._distributed_calls(graph)     # its errors here, in the script
@@ -384,6 +384,14 @@ class EngineBase:
         return out
 
     _distributed = None
+
+    def _distributed_solver(self) -> Optional[str]:
+        """The PETSc solver name that makes this engine distributed under mpiexec (its
+        ``solver``, or for a heat engine the integrator's), or None."""
+        for name in (self._options.get("solver"), getattr(self, "_thermal", {}).get("thermal_solver")):
+            if isinstance(name, str) and name.startswith("petsc"):
+                return name
+        return None
 
     def _distributed_calls(self, graph):
         """The DistributedCalls of this engine on the first ``graph`` (a subclass's)."""
