@@ -66,10 +66,11 @@ def spread_over_parts(network: LocalNetwork, exchange: GhostExchange, owned_valu
 class _Share:
     """What both physics set up on a share: the ghost exchange, the unknowns, the rows."""
 
-    def __init__(self, network: LocalNetwork, fixed_owned, comm, preconditioner, rtol, pos, spacing, options):
+    def __init__(self, network: LocalNetwork, fixed_owned, comm, preconditioner, rtol, pos, spacing, options,
+                 exchange: Optional[GhostExchange] = None):
         self.network = network
         self.comm = mpi_comm(comm)
-        self.exchange = GhostExchange(network, self.comm)
+        self.exchange = GhostExchange(network, self.comm) if exchange is None else exchange
         fixed = np.asarray(fixed_owned, dtype=bool)
         if fixed.shape != (network.n_owned,):
             raise ValueError(f"one fixed flag per owned node ({network.n_owned}), got {fixed.shape}")
@@ -127,8 +128,8 @@ class PartitionedConduction:
             heads = int(comm.allreduce(int(np.count_nonzero(self.floating & (part == network.owned_key)))))
             if comm.Get_rank() == 0:
                 warnings.warn(floating_message(n_float, heads, "electrode", "a potential of 0 V"), stacklevel=2)
-        self._share = _Share(network, (el >= 0) | self.floating, comm, preconditioner, rtol, pos, spacing, options)
-        self._share.exchange = ex
+        self._share = _Share(network, (el >= 0) | self.floating, comm, preconditioner, rtol, pos, spacing, options,
+                             exchange=ex)
         self.electrode_of = el
         self._el_local = ex.local(np.where(self.floating, len(self.names), el))
         self._x = None
