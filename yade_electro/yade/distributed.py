@@ -141,7 +141,7 @@ class DistributedCalls:
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
         self.rank = model.comm.Get_rank()
         self.size = model.comm.Get_size()
-        self._slab_axis, self._bounds, self._owner_by_id = None, None, {}
+        self._slab_axis, self._bounds, self._owner_by_id = None, None, np.zeros(0, np.int64)
         self._last_time = float(O.time)
         self.share = None
 
@@ -165,12 +165,13 @@ class DistributedCalls:
             self._slab_axis = int(np.argmax(np.ptp(graph.pos, axis=0)))
             x = np.sort(graph.pos[:, self._slab_axis])
             self._bounds = x[(np.arange(1, self.size) * x.shape[0]) // self.size]
-        by_pos = np.searchsorted(self._bounds, graph.pos[:, self._slab_axis], side="right")
-        known = self._owner_by_id
-        owner = np.fromiter((known.get(i, -1) for i in graph.ids.tolist()), np.int64, graph.n_nodes)
+        known = self._owner_by_id                         # owner by body id, -1: not seen yet
+        if known.shape[0] <= int(graph.ids.max()):
+            known = self._owner_by_id = np.concatenate([known, np.full(int(graph.ids.max()) + 1 - known.shape[0], -1)])
+        owner = known[graph.ids]
         new = owner < 0
-        owner[new] = by_pos[new]
-        known.update(zip(graph.ids[new].tolist(), owner[new].tolist()))
+        owner[new] = np.searchsorted(self._bounds, graph.pos[new, self._slab_axis], side="right")
+        known[graph.ids[new]] = owner[new]
         return owner
 
     def abort(self, exc: BaseException):
