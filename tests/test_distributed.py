@@ -6,6 +6,8 @@ import json
 import os
 import subprocess
 
+import pytest
+
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
@@ -63,3 +65,44 @@ def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
     refused = [line for line in res.stdout.splitlines() if line.startswith("REFUSED")]
     assert res.returncode == 0 and len(refused) == 2, res.stdout[-2000:] + res.stderr[-3000:]
     assert "current-driven electrodes" in refused[0] and "solver='petsc'" in refused[0]
+
+
+FAIL_SCRIPT = """
+import numpy as np
+from yade_electro.yade import ElectricalEngine, Electrode, Material, Reader
+from yade_electro.yade.distributed import world_rank
+for i in range(3):
+    for j in range(3):
+        for k in range(10):
+            O.bodies.append(sphere((i, j, k), 0.52))
+O.engines = [e for e in O.engines if type(e).__name__ != "GlobalStiffnessTimeStepper"]
+O.dt = 1e-6
+ids = np.arange(len(O.bodies))
+z = np.array([b.state.pos[2] for b in O.bodies])
+eng = ElectricalEngine(material=Material(resistivity=1e-6), reader=Reader(bonds="contacts"), law="contact",
+                       boundaries=[Electrode("a", select=ids[z < 0.5], potential=1.0),
+                                   Electrode("b", select=ids[z > 8.5], potential=0.0)],
+                       solver="petsc", iterPeriod=1)
+O.engines = O.engines + [eng.runner]
+O.run(2, True)
+eng.set_electrode("a", 2.0)
+O.run(1, True)
+print("R_EQ", world_rank(), eng.equivalent_resistance, eng.electrode_currents["a"], flush=True)
+if world_rank() == 1:
+    O.bodies[int(ids[-1])].shape.radius = -1.0      # this rank's reader now fails; the other waits for it
+O.run(2, True)
+print("NOT REACHED", flush=True)
+"""
+
+
+def test_a_failing_rank_ends_every_rank(yade_exe, tmp_path):
+    script = tmp_path / "fail.py"
+    script.write_text(FAIL_SCRIPT)
+    res = _mpiexec(yade_exe + ["-n", "-x", str(script)], 2, timeout=300)
+    out = res.stdout + res.stderr
+    assert res.returncode != 0, out[-3000:]
+    assert "NOT REACHED" not in out and "ending all ranks (MPI_Abort)" in out, out[-3000:]
+    assert "radius must be finite" in out
+    rows = [line.split() for line in res.stdout.splitlines() if line.startswith("R_EQ")]
+    assert len(rows) == 2 and rows[0][2] == rows[1][2]               # the same R_eq on both ranks
+    assert float(rows[0][3]) == pytest.approx(2.0 / float(rows[0][2]), rel=1e-8)   # the new potential acts

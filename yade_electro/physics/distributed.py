@@ -281,7 +281,7 @@ class DistributedElectroThermal:
         row: Dict[str, float] = {}
         if self.conduction is not None:
             self.conduction.update_conductance(self._conductance(self.T))
-            self.conduction.solve()
+            self.conduction.solve([e.value for e in self.electrodes])
             power = self.eta * self.conduction.joule_power()
             currents = self.conduction.electrode_currents()
             row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
@@ -301,6 +301,14 @@ class DistributedElectroThermal:
             row["heat_content"] = self.heat.heat_content(float(self.material.reference_temperature or 0.0))
         row["elements"] = int(self.comm.allreduce(int(share.n_owned)))
         return row
+
+    def set_electrode(self, name: str, potential: float):
+        """A new potential [V] for electrode ``name`` from the next call on (every rank)."""
+        names = [e.name for e in self.electrodes]
+        if name not in names:
+            raise BoundaryConditionError(f"no electrode named {name!r}; have {names}")
+        k = names.index(name)
+        self.electrodes[k] = Held(name, self.electrodes[k].select, float(potential))
 
     @property
     def potential(self) -> np.ndarray:

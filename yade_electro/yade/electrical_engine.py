@@ -242,8 +242,11 @@ class ElectricalEngine(EngineBase):
 
     # -- stepping ------------------------------------------------------------------------
     def set_electrode(self, name: str, value: float):
-        """Change an electrode's potential [V] or current [A] from the next call on."""
-        self.model.set_electrode(name, value)
+        """Change an electrode's potential [V] or current [A] from the next call on (distributed:
+        call it on every rank with the same value, as a script does)."""
+        self.model.set_electrode(name, value)          # checks the name and the value
+        if self._distributed is not None:
+            self._distributed.model.set_electrode(name, self.model.values[name])
 
     def _step(self):
         graph = self.reader.read()
