@@ -82,9 +82,12 @@ class _Share:
         self.system = PartitionedSystem(self.rows, self.n_global, self.comm, preconditioner=preconditioner,
                                         rtol=rtol, coords=coords, spacing=spacing, options=options)
 
-    def total(self, x):
-        """Sum over the ranks."""
-        return self.comm.allreduce(x)
+    def edge_values(self, values, error, message: str) -> np.ndarray:
+        """``values`` as one finite float >= 0 per edge of the share, else ``error(message)``."""
+        c = np.asarray(values, dtype=float)
+        if c.shape != (self.network.edges.shape[0],) or not np.all(np.isfinite(c)) or np.any(c < 0):
+            raise error(message)
+        return c
 
 
 class PartitionedConduction:
@@ -156,11 +159,9 @@ class PartitionedConduction:
 
     def update_conductance(self, conductance):
         """New edge conductances [S], same edges (collective); the setup is kept."""
-        c = np.asarray(conductance, dtype=float)
-        if c.shape != (self.network.edges.shape[0],) or not np.all(np.isfinite(c)) or np.any(c < 0):
-            raise BoundaryConditionError("conductances must be finite and >= 0 (S), one per edge of the share")
-        self.conductance = c
         s = self._share
+        c = self.conductance = s.edge_values(conductance, BoundaryConditionError,
+                                             "conductances must be finite and >= 0 (S), one per edge of the share")
         s.system.set_values(s.rows.values(c), s.exchange)
 
     def solve(self, values=None):
@@ -258,10 +259,8 @@ class PartitionedHeat:
 
     def update_conductance(self, conductance):
         """New edge conductances [W/K], same edges (collective)."""
-        c = np.asarray(conductance, dtype=float)
-        if c.shape != (self.network.edges.shape[0],) or not np.all(np.isfinite(c)) or np.any(c < 0):
-            raise ThermalError("thermal conductances must be finite and >= 0 (W/K), one per edge of the share")
-        self.conductance = c
+        self.conductance = self._share.edge_values(
+            conductance, ThermalError, "thermal conductances must be finite and >= 0 (W/K), one per edge of the share")
         self._dt = None                         # the step matrix is made again at the next step
 
     def _free(self, a):
@@ -337,7 +336,7 @@ class PartitionedHeat:
 
     def heat_content(self, reference: float = 0.0) -> float:
         """sum C (T - reference) [J] over all ranks."""
-        return float(self._share.total(float(self.capacity @ (self.T - reference))))
+        return float(summed(self._share.comm, [self.capacity @ (self.T - reference)])[0])
 
 
 def out_of_owned(network: LocalNetwork, per_edge) -> np.ndarray:
