@@ -146,7 +146,7 @@ class DistributedElectroThermal:
         self.preconditioner, self.rtol = preconditioner, float(rtol)
         self.comm = mpi_comm(comm)
         self._ids: Dict[str, np.ndarray] = {}
-        self._T_by_id: Optional[Dict[int, float]] = None
+        self._T_kept = None              # (sorted ids, their temperatures) of the last share
         self.share: Optional[Share] = None
         self.conduction: Optional[PartitionedConduction] = None
         self.heat: Optional[PartitionedHeat] = None
@@ -202,14 +202,15 @@ class DistributedElectroThermal:
         """Thermal conductances [W/K] of the share's edges."""
         return thermal_conductance_of(self.factor, self.material.conductivity, self.share.network.edges)
 
-    def prepare(self, share: Share):
+    def prepare(self, share: Share, factor=None):
         """Set up the solves on a new share (new element set or edges), carrying the temperatures
-        of the elements kept (by id)."""
+        of the elements kept (by id); ``factor``: the share's geometric factors when the caller
+        has them."""
         self.share = share
         net = share.network
         exchange = GhostExchange(net, self.comm)
         self._exchange = exchange
-        self.factor = self._factor(share, exchange)
+        self.factor = self._factor(share, exchange) if factor is None else factor
         n = share.n_owned
         pos = share.graph.pos[:n] if share.graph is not None else np.zeros((0, 3))
         spacing = self._spacing(share)
@@ -252,17 +253,24 @@ class DistributedElectroThermal:
         n = share.n_owned
         T0 = float(self.temperature0) if self.temperature0 is not None else float(
             self.material.reference_temperature or 0.0)
-        if self._T_by_id is None:
-            return np.full(n, T0)
-        return np.array([self._T_by_id.get(int(i), T0) for i in share.owned_ids.tolist()])
+        T = np.full(n, T0)
+        if self._T_kept is not None and n:               # the elements kept take their temperature
+            ids, temps = self._T_kept
+            at = np.minimum(np.searchsorted(ids, share.owned_ids), max(ids.size - 1, 0))
+            kept = ids[at] == share.owned_ids if ids.size else np.zeros(n, bool)
+            T[kept] = temps[at[kept]]
+        return T
 
     # -- one call ----------------------------------------------------------------------------
     def step(self, share: Share, dt: Optional[float]) -> dict:
         """One call on ``share`` (a new element set or edge set rebuilds the solves, else the
         values are refreshed in place): the potential, the Joule heat, and a heat step of
         ``dt`` [s] (None or 0: no heat step). Returns the totals of all ranks."""
-        if is_contact_law(self.law_name) and share.graph is not None:
-            share = share.conducting(self.law.factor(share.graph, share.graph.edges) > 0)
+        factor = None
+        if is_contact_law(self.law_name) and share.graph is not None:   # pair factors: once, on all contacts
+            factor = self.law.factor(share.graph, share.graph.edges)
+            touching = factor > 0
+            share, factor = share.conducting(touching), factor[touching]
         old = self.share
         changed = (old is None or share.network.edges.shape != old.network.edges.shape
                    or not np.array_equal(share.network.owned_key, old.network.owned_key)
@@ -270,11 +278,12 @@ class DistributedElectroThermal:
                    or not np.array_equal(share.network.edges, old.network.edges))
         if self.comm.allreduce(int(changed)):        # one rank's new structure is everyone's new setup
             if old is not None:
-                self._T_by_id = dict(zip(old.owned_ids.tolist(), self.T.tolist()))
-            self.prepare(share)
+                order = np.argsort(old.owned_ids)
+                self._T_kept = (old.owned_ids[order], self.T[order])
+            self.prepare(share, factor)
         else:
             self.share = share
-            self.factor = self._factor(share, self._exchange)
+            self.factor = self._factor(share, self._exchange) if factor is None else factor
             if self.heat is not None:
                 self.heat.update_conductance(self._thermal())
         power = np.zeros(share.n_owned)
