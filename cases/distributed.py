@@ -335,8 +335,6 @@ def engine_memory(n: int, solver: str, calls: int = 2) -> dict:
     yade = import_yade()
     O = yade.Omega()
     ids, x, r = build_bed(n, gravity=0.0)
-    from yade import pack
-    del pack
     for b in O.bodies:                       # touching neighbours: grow the spheres by 1 %
         if isinstance(b.shape, yade.Sphere):
             b.shape.radius *= 1.01

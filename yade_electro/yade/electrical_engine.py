@@ -219,9 +219,15 @@ class ElectricalEngine(EngineBase):
         self._apply_materials()
         self.model.update(graph)
 
+    def _electrode_ids(self, graph) -> dict:
+        """Body ids each selected electrode chose on ``graph`` (surface and wall electrodes have none)."""
+        if self.model is None:
+            return {}
+        chosen = {s.name for s in self.model.specs if s.surface is None and not s.wall}
+        return {name: graph.ids[m.nodes(graph)] for name, m in self.model.memberships.items() if name in chosen}
+
     def _distributed_calls(self, graph):
-        ids = {name: graph.ids[m.nodes(graph)] for name, m in self.model.memberships.items()
-               if any(s.name == name and s.surface is None and not s.wall for s in self.model.specs)}
+        ids = self._electrode_ids(graph)
         model = distributed_model(solver=self._distributed_solver(), resistivity=self._resistivity,
                                   materials=self._materials_config, law=self._options["law"],
                                   law_params=self._law_params, electrodes=self.model.specs, electrode_ids=ids,

@@ -358,8 +358,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
             raise BoundaryConditionError("a distributed run (solver='petsc' under mpiexec) does not do steady states, "
                                          "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
         specs = self.model.specs if self.model is not None else ()
-        ids = {name: graph.ids[m.nodes(graph)] for name, m in (self.model.memberships.items() if self.model else ())
-               if any(s.name == name and s.surface is None and not s.wall for s in specs)}
+        ids = self._electrode_ids(graph)
         cond_ids = {name: graph.ids[m.nodes(graph)] for name, m in c.bc_memberships.items()
                     if any(b.name == name and getattr(b, "surface", None) is None for b in self._heat_conditions)}
         vf = c.volume_fraction if not callable(c.volume_fraction) else None

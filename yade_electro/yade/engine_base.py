@@ -21,7 +21,7 @@ from ..core.materials import real_number
 from . import persistence
 from . import registry
 from .runtime import MPY_REFUSAL, import_yade, in_mpy_subdomain
-from .distributed import distributed_requested, world_rank
+from .distributed import PETSC_SOLVERS, distributed_requested, world_rank
 from .granular import GranularReader
 from .scene import SceneReader, check_write_back, predicate_selector
 
@@ -389,7 +389,7 @@ class EngineBase:
         """The PETSc solver name that makes this engine distributed under mpiexec (its
         ``solver``, or for a heat engine the integrator's), or None."""
         for name in (self._options.get("solver"), getattr(self, "_thermal", {}).get("thermal_solver")):
-            if isinstance(name, str) and name.startswith("petsc"):
+            if isinstance(name, str) and name in PETSC_SOLVERS:
                 return name
         return None
 
