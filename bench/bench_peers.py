@@ -24,11 +24,13 @@ after a +-1 % change of every conductance (setup kept where the solver keeps one
 Tolerance 1e-10 on the unpreconditioned residual. One JSON line per system and size.
 
 Partitioned part (``--ranks``): ``mpiexec -n P`` runs of this script (``--worker``), each rank
-owning a z slab of the same system, our deflation, BoomerAMG and GAMG as the preconditioner of
-the partitioned CG (:mod:`yade_electro.solvers.partitioned`); cold and re-solve, rank 0 prints
-one JSON line per system, size and P. A last line extrapolates our iteration count to 10M and
-100M unknowns (a power law through the measured counts) and names the size at which AMG's
-(flat) count would make it faster, from the measured time per iteration of each.
+owning a z slab of the same system, our deflation (ICC smoother, the default, and
+``deflation_jacobi`` for reference), BoomerAMG and GAMG as the preconditioner of the partitioned
+CG (:mod:`yade_electro.solvers.partitioned`); cold and re-solve, rank 0 prints one JSON line
+per system, size and P. The last lines extrapolate our iteration count to 10M and 100M unknowns
+(a power law through the measured counts) and name the size at which AMG's (flat) count would
+make it faster, from the measured time per iteration of each: serially (``ranks`` 0) and for
+each rank count. ``--parts serial`` or ``--parts partitioned`` runs one part only.
 """
 from __future__ import annotations
 
@@ -195,13 +197,15 @@ def worker(kinds, sizes, repeat, cache_dir):
             row = {"bench": "peers", "part": "partitioned", "system": kind, "n": int(g.n_nodes), "ranks": size,
                    "unknowns": int(n_global)}
             c2 = c * (1.0 + 0.01 * np.random.default_rng(2).uniform(-1.0, 1.0, c.size))
-            for pc in ("deflation", "hypre", "gamg"):
+            for name in ("deflation", "deflation_jacobi", "hypre", "gamg"):
+                pc = name.split("_")[0]
                 best, best2, it, it2 = np.inf, np.inf, 0, 0
                 for _ in range(repeat):
                     comm.Barrier()
                     t = time.perf_counter()
                     ps = PartitionedSystem(rows, n_global, comm, preconditioner=pc, rtol=RTOL,
-                                           coords=g.pos[own][rows.free_owned], spacing=spacing)
+                                           coords=g.pos[own][rows.free_owned], spacing=spacing,
+                                           smoother="jacobi" if name.endswith("jacobi") else "icc")
                     ps.set_values(rows.values(c[held]), ex)
                     x, info = ps.solve(rows.fixed_rhs(c[held], v))
                     comm.Barrier()
@@ -211,7 +215,7 @@ def worker(kinds, sizes, repeat, cache_dir):
                     x, info = ps.solve(rows.fixed_rhs(c2[held], v), x0=x)
                     comm.Barrier()
                     best2, it2 = min(best2, time.perf_counter() - t), info["iterations"]
-                row[pc] = {"cold_s": best, "iterations": it, "resolve_s": best2, "resolve_iterations": it2}
+                row[name] = {"cold_s": best, "iterations": it, "resolve_s": best2, "resolve_iterations": it2}
             row["loadavg"] = os.getloadavg()[0]
             if rank == 0:
                 print(json.dumps(row), flush=True)
@@ -230,29 +234,45 @@ def run_ranks(ranks, kinds, sizes, repeat, cache_dir):
     return [json.loads(line) for line in res.stdout.splitlines() if line.startswith("{")]
 
 
+def _crossing(kind, n, it, unknowns, t_ours_cold, amg, t_amg_cold, **extra):
+    """Our iteration count as a power of the size through (n, it), extrapolated to 10M and
+    100M; AMG's count taken flat; times per iteration per unknown from the largest size."""
+    p, a = np.polyfit(np.log(n), np.log(it), 1)
+    t_ours = t_ours_cold / (it[-1] * unknowns)
+    t_amg_it = t_amg_cold / unknowns                   # per unknown, for its (flat) count
+    est = {}
+    for N in (1e7, 1e8):
+        its_N = float(np.exp(a) * N ** p)
+        est[f"{N:.0e}"] = {"ours_iterations": its_N, "ours_s": t_ours * its_N * N, "amg_s": t_amg_it * N}
+    # ours: t_ours * exp(a) N^(1+p); AMG: t_amg_it * N -> equal at N^p = t_amg_it / (t_ours exp(a))
+    cross = float((t_amg_it / (t_ours * np.exp(a))) ** (1.0 / p)) if p > 0 else float("inf")
+    return dict({"bench": "peers", "part": "extrapolation", "system": kind, "iteration_exponent": float(p),
+                 "amg": amg, "estimates": est, "amg_wins_above_unknowns": cross}, **extra)
+
+
 def extrapolate(rows):
-    """Our iteration count as a power of the size, extrapolated; AMG's taken flat (its largest
-    measured count); times per iteration per unknown from the largest size measured."""
+    """The serial rows' extrapolation (see :func:`_crossing`), and that of the partitioned
+    rows of each rank count (our deflation against the faster of BoomerAMG and GAMG cold)."""
     out = []
-    for kind in sorted({r["system"] for r in rows}):
-        rr = sorted((r for r in rows if r["system"] == kind), key=lambda r: r["unknowns"])
+    for kind in sorted({r["system"] for r in rows if r["part"] == "serial"}):
+        rr = sorted((r for r in rows if r["part"] == "serial" and r["system"] == kind), key=lambda r: r["unknowns"])
         if len(rr) < 2:
             continue
-        n = np.array([r["unknowns"] for r in rr], float)
-        it = np.array([r["iterations"]["ours"] for r in rr], float)
-        p, a = np.polyfit(np.log(n), np.log(it), 1)
         big = rr[-1]
         amg = min(("boomeramg", "gamg", "pyamg"), key=lambda k: big["cold_s"][k])
-        t_ours = big["cold_s"]["ours"] / (big["iterations"]["ours"] * big["unknowns"])
-        t_amg_it = big["cold_s"][amg] / big["unknowns"]          # per unknown, for its (flat) count
-        est = {}
-        for N in (1e7, 1e8):
-            its_N = float(np.exp(a) * N ** p)
-            est[f"{N:.0e}"] = {"ours_iterations": its_N, "ours_s": t_ours * its_N * N, "amg_s": t_amg_it * N}
-        # ours: t_ours * exp(a) N^(1+p); AMG: t_amg_it * N -> equal at N^p = t_amg_it / (t_ours exp(a))
-        cross = float((t_amg_it / (t_ours * np.exp(a))) ** (1.0 / p)) if p > 0 else float("inf")
-        out.append({"bench": "peers", "part": "extrapolation", "system": kind, "iteration_exponent": float(p),
-                    "amg": amg, "estimates": est, "amg_wins_above_unknowns": cross})
+        out.append(_crossing(kind, np.array([r["unknowns"] for r in rr], float),
+                             np.array([r["iterations"]["ours"] for r in rr], float), big["unknowns"],
+                             big["cold_s"]["ours"], amg, big["cold_s"][amg], ranks=0))
+    for kind, P in sorted({(r["system"], r["ranks"]) for r in rows if r["part"] == "partitioned"}):
+        rr = sorted((r for r in rows if r["part"] == "partitioned" and r["system"] == kind and r["ranks"] == P),
+                    key=lambda r: r["unknowns"])
+        if len(rr) < 2:
+            continue
+        big = rr[-1]
+        amg = min(("hypre", "gamg"), key=lambda k: big[k]["cold_s"])
+        out.append(_crossing(kind, np.array([r["unknowns"] for r in rr], float),
+                             np.array([r["deflation"]["iterations"] for r in rr], float), big["unknowns"],
+                             big["deflation"]["cold_s"], amg, big[amg]["cold_s"], ranks=P))
     return out
 
 
@@ -265,6 +285,7 @@ def main(argv=None):
     ap.add_argument("--ranks", default="1,2,3", help="mpiexec rank counts of the partitioned part ('' for none)")
     ap.add_argument("--cache-dir", default=os.path.join(tempfile.gettempdir(), "yade_electro_bench_packings"))
     ap.add_argument("--out", default=None, help="also append the JSON lines to this file")
+    ap.add_argument("--parts", default="serial,partitioned", help="which parts to run")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",") if s]
@@ -272,7 +293,7 @@ def main(argv=None):
     if args.worker:
         return worker(kinds, sizes, args.repeat, args.cache_dir)
     from bench_scale import eigen_driver
-    exe = eigen_driver()
+    exe = eigen_driver() if "serial" in args.parts.split(",") else None
     rows = []
 
     def emit(row):
@@ -280,21 +301,23 @@ def main(argv=None):
         if args.out:
             with open(args.out, "a") as fh:
                 fh.write(json.dumps(row) + "\n")
+    parts = args.parts.split(",")
     with tempfile.TemporaryDirectory() as tmp:
-        for kind in kinds:
+        for kind in (kinds if "serial" in parts else []):
             for n in sizes:
                 if kind == "voronoi" and n > args.voronoi_max:
                     continue
                 row = serial_block(kind, n, args.repeat, exe, tmp, args.cache_dir)
                 rows.append(row)
                 emit(row)
-    for row in extrapolate(rows):
-        emit(row)
-    for p in [int(r) for r in args.ranks.split(",") if r]:
+    for p in [int(r) for r in args.ranks.split(",") if r and "partitioned" in parts]:
         for kind in kinds:
             ks = [n for n in sizes if kind != "voronoi" or n <= args.voronoi_max]
             for row in run_ranks(p, [kind], ks, args.repeat, args.cache_dir):
+                rows.append(row)
                 emit(row)
+    for row in extrapolate(rows):
+        emit(row)
 
 
 if __name__ == "__main__":

@@ -75,6 +75,21 @@ for pc in ("deflation", "hypre", "gamg"):
                "floating_ok": bool(np.all(phi[:share.n_owned][np.isin(own, float_nodes)] == 0.0))}
 out["serial_floating_warned"] = [str(x.message) for x in w_ser][:1]
 
+# -- values changed up to a hundredfold on the kept setup (the deflation's smoother and coarse
+# factor are rebuilt when the iterations grow) ---------------------------------------------
+c3 = c * np.exp(rng.uniform(np.log(0.01), np.log(100.0), c.size))
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    sol3 = ConductionProblem(n, edges, c3, [Electrode("a", bottom, potential=1.0), Electrode("b", top, potential=0.0)],
+                             solver="direct").solve()
+    pcnd = PartitionedConduction(share, c[held], el, ["a", "b"], {"a": 1.0, "b": 0.0}, comm=comm,
+                                 preconditioner="deflation", rtol=1e-12, pos=g.pos[own], spacing=2e-4)
+    pcnd.solve()
+    pcnd.update_conductance(c3[held])
+    phi = pcnd.solve()
+d_phi = max(comm.allgather(float(np.max(np.abs(phi[:share.n_owned] - sol3.potential[own]), initial=0.0))))
+out["changed"] = {"max_dphi_V": d_phi, "iterations": pcnd.info["iterations"], "setups": pcnd.info["setups"]}
+
 # -- heat -----------------------------------------------------------------------------------
 C = rng.uniform(1e-3, 2e-3, n)
 G = c * 1e-2
