@@ -122,9 +122,9 @@ def _pair(make, calls, steps_per_call, electrical=True):
 
 
 # -- the rod --------------------------------------------------------------------------------
-def rod_case(n=3000, calls=5, cache_dir=None):
+def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi"):
     from rod_resistance import RHO_304L, build_rod
-    from yade_electro.yade import ElectroThermalEngine, Electrode, FixedTemperature, Integrator, Material, Output
+    from yade_electro.yade import ElectroThermalEngine, Electrode, FixedTemperature, Integrator, Law, Material, Output
     spec = build_rod(n=n, seed=1, cache_dir=cache_dir)
     ids = spec["ids"]
     mat = Material(resistivity=RHO_304L, density=7900.0, specific_heat=500.0, conductivity=16.0, beta=1e-3,
@@ -132,7 +132,7 @@ def rod_case(n=3000, calls=5, cache_dir=None):
 
     def make(solver, label):
         return ElectroThermalEngine(
-            material=mat, law="continuum",
+            material=mat, law=Law("voronoi", container=spec["container"]) if law == "voronoi" else law,
             boundaries=[Electrode("top", select=ids[spec["top"]], potential=1.0),
                         Electrode("bottom", select=ids[spec["bottom"]], potential=0.0),
                         FixedTemperature("cold", nodes=ids[spec["bottom"]], temperature=T0)],
@@ -142,14 +142,15 @@ def rod_case(n=3000, calls=5, cache_dir=None):
 
 
 # -- the pin ---------------------------------------------------------------------------------
-def pin_case(n=1000, rate_factor=20.0, every=100, theta_max=0.12, cache_dir=None):
+def pin_case(n=1000, rate_factor=20.0, every=100, theta_max=0.12, cache_dir=None, law="continuum"):
     """The pin torsion test (pin_torsion's pin and rig, its kept calibration for ``n``), twisted
-    ``rate_factor`` times faster than the paper until ``theta_max`` or separation, with the
-    continuum law's engine (end element layers) serial and distributed side by side: bonds
-    break, the share's edges change, the solves are rebuilt on every rank."""
+    ``rate_factor`` times faster than the paper until ``theta_max`` or separation, with an
+    engine on the end element layers serial and distributed side by side: bonds break, the
+    share's edges change, the solves are rebuilt on every rank. ``law``: 'continuum' (the
+    paper's), or 'voronoi' with crack='facets' (the broken bonds' facets cut the faces)."""
     import math
     from pin_torsion import RAMP_ANGLE, RESISTIVITY, build_pin, load_calibration, paper_rate, pin_electrodes
-    from yade_electro.yade import ElectricalEngine, Material, Output, Reader, electrodes_from_dict
+    from yade_electro.yade import ElectricalEngine, Law, Material, Output, Reader, electrodes_from_dict
     yade = import_yade()
     O = yade.Omega()
     cal = load_calibration(n, 1, cache_dir=cache_dir, progress=_say)
@@ -157,10 +158,15 @@ def pin_case(n=1000, rate_factor=20.0, every=100, theta_max=0.12, cache_dir=None
     pin = build_pin(n, 1, cal["young"], cal["strength"], rate=rate, ramp_time=2 * RAMP_ANGLE / rate,
                     cache_dir=cache_dir)
     electrodes, _ = pin_electrodes(pin, "continuum")
+    # positions read at every call: a reader refreshes them lazily (every few calls, or when a
+    # bond it holds breaks), and a rank holds a region, not the scene, so the two engines would
+    # otherwise see positions of different calls (measured: up to 8e-4 in R_eq at one call)
+    chosen = Law("voronoi", container=pin["container"], crack="facets") if law == "voronoi" else law
 
     def make(solver, label):
         return ElectricalEngine(material=Material(resistivity=RESISTIVITY), boundaries=electrodes_from_dict(electrodes),
-                                law="continuum", reader=Reader(bond_check="flags"), output=Output(write_back=None),
+                                law=chosen, reader=Reader(bond_check="flags", geometry_every=1, move_tolerance=0.0),
+                                output=Output(write_back=None),
                                 solver=solver, iterPeriod=every, label=label)
     ser, dis = make("direct", "pin_ser"), make("petsc", "pin_dis")
     O.engines = O.engines + [ser.runner, dis.runner]
@@ -187,7 +193,7 @@ def pin_case(n=1000, rate_factor=20.0, every=100, theta_max=0.12, cache_dir=None
     R0 = ser.history.rows[0]["R_eq"]
     return {"calls": len(dis.history.rows), "theta": float(rig.theta), "R_eq_first": R0,
             "R_ratio_last_finite": last_finite[-1]["R_eq"] / R0 if last_finite else None,
-            "separated": not math.isfinite(ser.history.rows[-1]["R_eq"]), "R_rel_diff": d_R,
+            "law": law, "separated": not math.isfinite(ser.history.rows[-1]["R_eq"]), "R_rel_diff": d_R,
             "potential_diff_over_V": d_phi, "compared_calls": finite, "elements": int(len(pin["ids"])),
             "wall_s": wall, "max_rel_diff": max(d_R, d_phi)}
 
@@ -392,7 +398,8 @@ def mem_case(n: int) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="rod,pin,bed,heat,mpy", help="comma-separated: rod, pin, bed, heat, mpy, mem")
+    ap.add_argument("--cases", default="rod,rod-continuum,pin,pin-voronoi,bed,heat,mpy",
+                    help="comma-separated: rod, rod-continuum, pin, pin-voronoi, bed, heat, mpy, mem")
     ap.add_argument("--quick", action="store_true", help="small sizes (the CI test)")
     ap.add_argument("--n-rod", type=int, default=3000)
     ap.add_argument("--n-bed", type=int, default=400)
@@ -413,10 +420,17 @@ def main(argv=None):
     if "rod" in cases:
         _say(f"rod: {n_rod} elements")
         out["rod"] = rod_case(n_rod, cache_dir=args.cache_dir)
+    if "rod-continuum" in cases:
+        _say(f"rod, continuum law: {n_rod} elements")
+        out["rod_continuum"] = rod_case(n_rod, cache_dir=args.cache_dir, law="continuum")
     if "pin" in cases:
         n_pin = 1000 if args.quick else args.n_pin
         _say(f"pin: {n_pin} elements")
         out["pin"] = pin_case(n_pin, cache_dir=args.cache_dir)
+    if "pin-voronoi" in cases:
+        n_pin = 1000 if args.quick else args.n_pin
+        _say(f"pin, voronoi law with crack facets: {n_pin} elements")
+        out["pin_voronoi"] = pin_case(n_pin, cache_dir=args.cache_dir, law="voronoi")
     if "bed" in cases:
         _say(f"bed: about {n_bed} spheres")
         out["bed"] = bed_case(n_bed)

@@ -88,6 +88,60 @@ def test_partitioned_solves_match_the_serial_ones(ranks):
         assert r["max_dphi_V"] < 1e-10 and r["R_rel_diff"] < 1e-10 and r["I_a_rel_diff"] < 1e-10, (pc, r)
         assert abs(r["I_sum"]) < 1e-10 and r["max_dP_rel"] < 1e-9, (pc, r)
         assert r["floating_ok"] and r["floating_warned"] == out["serial_floating_warned"], (pc, r)
+    assert out["changed"]["max_dphi_V"] < 1e-9, out["changed"]
     for theta in ("0", "0.5", "1"):
         h = out[f"heat_theta_{theta}"]
         assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_voronoi_shares_of_regions_are_the_whole_tessellations(ranks):
+    """Each rank tessellates only its region (its slab and a halo of hops + 3 diameters):
+    the factors, cell volumes and conducting pairs of its owned elements are the whole
+    packing's, before and after bonds break (crack facets)."""
+    from scipy.spatial import cKDTree
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.geometry.shapes import Cylinder
+    from yade_electro.laws.factors import make_law
+    from yade_electro.physics.distributed import carve_region_share
+    rng = np.random.default_rng(5)
+    R, L, h = 1e-3, 4e-3, 0.2e-3
+    cyl = Cylinder((0, 0, 0), (0, 0, L), R)
+    g0 = cubic_lattice((11, 11, 21), r=0.5 * h)          # a jittered lattice cut to the cylinder
+    p = g0.pos - g0.pos.mean(axis=0) + np.array([0, 0, L / 2]) + rng.uniform(-0.15, 0.15, g0.pos.shape) * h
+    p = p[(np.hypot(p[:, 0], p[:, 1]) < R - 0.3 * h) & (p[:, 2] > 0.3 * h) & (p[:, 2] < L - 0.3 * h)]
+    rad = rng.uniform(0.45, 0.55, p.shape[0]) * h
+    bonds = cKDTree(p).query_pairs(1.2 * h, output_type="ndarray")
+    ids = np.arange(p.shape[0]) * 3 + 7                   # body ids are not node indices
+    whole = ContactGraph(p, rad, bonds, ids=ids)
+    broken = bonds[rng.random(bonds.shape[0]) > 0.9]      # 10 % of the bonds break
+    left = bonds[~np.isin(bonds[:, 0] * p.shape[0] + bonds[:, 1], broken[:, 0] * p.shape[0] + broken[:, 1])]
+    serial = make_law("voronoi", container=cyl)
+    ref = {}
+    for stage, b in (("intact", bonds), ("cracked", left)):
+        g = whole.with_edges(b)
+        pairs = serial.network(g)
+        ref[stage] = dict(zip(map(tuple, np.sort(ids[pairs], axis=1).tolist()), serial.factor(g, pairs)))
+    vol = dict(zip(ids.tolist(), serial.cell_volumes(whole)))
+    z = p[:, 2]
+    owner = np.minimum((z / L * ranks).astype(int), ranks - 1)
+    halo = (3 + 2 + 1) * 2 * rad.max()
+    for r in range(ranks):
+        own = owner == r
+        d, _ = cKDTree(p[own]).query(p, distance_upper_bound=halo)
+        keep = np.flatnonzero(np.isfinite(d))
+        local = np.full(p.shape[0], -1)
+        local[keep] = np.arange(keep.size)
+        law = make_law("voronoi", container=cyl, radius_range=(rad.min(), rad.max()))
+        for stage, b in (("intact", bonds), ("cracked", left)):
+            inside = b[(local[b[:, 0]] >= 0) & (local[b[:, 1]] >= 0)]
+            region = ContactGraph(p[keep], rad[keep], local[inside], ids=ids[keep])
+            share = carve_region_share(region, owner[keep], r, law)
+            got = dict(zip(map(tuple, np.sort(share.graph.ids[share.network.edges], axis=1).tolist()), share.factor))
+            mine = set(ids[own].tolist())
+            want = {k: v for k, v in ref[stage].items() if k[0] in mine or k[1] in mine}
+            assert set(got) == set(want), (r, stage, len(set(got) ^ set(want)))
+            scale = float(np.median(list(want.values())))      # tiny clipped faces: their error is the scale's
+            assert max(abs(got[k] - want[k]) for k in want) < 1e-11 * scale
+            assert np.allclose(share.volume, [vol[i] for i in share.owned_ids.tolist()], rtol=1e-10, atol=0)
+        assert law.tessellations == 1                    # faces of the first configuration, kept

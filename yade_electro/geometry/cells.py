@@ -103,7 +103,7 @@ def _protrusion_integral(verts, count, centre, container, signed=True):
 
 
 def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
-                  planes_per_round: int = 2) -> BoundedCells:
+                  planes_per_round: int = 2, radius_range=None) -> BoundedCells:
     """Voronoi cells of the element centres bounded by the container: faces, volumes and
     boundary faces, from one tessellation (see the module doc for the ghosts).
 
@@ -123,6 +123,11 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     solid away (a re-entrant corner) is not used: such a cell is measured by sampling
     (:func:`_sampled_volume`, faces by :func:`_clipped_area`) and has no boundary faces.
 
+    ``radius_range``: (r_min, r_max) [m] of the whole packing when ``pos`` is a part of it
+    (a distributed rank's region): the ghosts' band (4 r_max) and the clipping tolerance
+    (``rel_tol`` 2 r_min) are then the whole packing's, so the part's inner cells are the
+    whole's. Default: those of ``radius``.
+
     Returns
     -------
     BoundedCells
@@ -131,11 +136,12 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     pos = np.asarray(pos, float)
     radius = np.asarray(radius, float)
     n = pos.shape[0]
-    ghosts, _, _, _ = ghost_points(pos, radius, container)
+    r_min, r_max = (float(np.min(radius)), float(np.max(radius))) if radius_range is None else map(float, radius_range)
+    ghosts, _, _, _ = ghost_points(pos, radius, container, band=4.0 * r_max)
     pts, tess = tessellate_with_ghosts(pos, radius, ghosts)
     n_real_and_ghosts = n + ghosts.shape[0]
     rp = tess.ridge_points
-    tol0 = rel_tol * 2.0 * float(np.min(radius))
+    tol0 = rel_tol * 2.0 * r_min
     vout = np.asarray(container.sdf(tess.vertices), float) > tol0
     flagged = tess.cells_touching(vout)
     flagged[n:] = False

@@ -107,10 +107,10 @@ class VoronoiFaces:
         self.extent = None if extent is None else np.asarray(extent)[order]
 
     @classmethod
-    def of(cls, graph, container):
+    def of(cls, graph, container, radius_range=None):
         """Faces of ``graph``'s elements in ``container``, from :func:`bounded_cells` (kept,
-        with the cell volumes and boundary faces of the same pass)."""
-        cells = bounded_cells(graph.pos, graph.radius, container)
+        with the cell volumes and boundary faces of the same pass; ``radius_range`` as there)."""
+        cells = bounded_cells(graph.pos, graph.radius, container, radius_range=radius_range)
         faces = cls(cells.pairs, cells.area, graph.n_nodes, cells.face_centre, cells.face_extent)
         faces.cells = cells
         return faces

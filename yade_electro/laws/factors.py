@@ -378,7 +378,7 @@ class VoronoiLaw(ConductanceLaw):
     name = "voronoi"
     needs_container = True
 
-    def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets"):
+    def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets", radius_range=None):
         if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
             raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
                              "and gradient(x) (e.g. yade_electro.geometry.shapes.as_shape(predicate)); "
@@ -394,6 +394,9 @@ class VoronoiLaw(ConductanceLaw):
         self._faces = None
         self._key = None
         self.tessellations = 0
+        #: (r_min, r_max) [m] of the whole packing when the graphs are a part of it (a
+        #: distributed rank's region; see :func:`~yade_electro.geometry.cells.bounded_cells`)
+        self.radius_range = None if radius_range is None else (float(radius_range[0]), float(radius_range[1]))
         #: how often the faces' areas were looked up for an edge list (once per list)
         self.area_lookups = 0
 
@@ -410,7 +413,7 @@ class VoronoiLaw(ConductanceLaw):
                 base = ContactGraph(ref[1], ref[2], bonds, ref[0])
             else:
                 base = graph
-            self._faces = VoronoiFaces.of(base, self.container)
+            self._faces = VoronoiFaces.of(base, self.container, self.radius_range)
             self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius), np.array(base.edges))
             self._key = key
             self.tessellations += 1

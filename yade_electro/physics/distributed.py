@@ -14,9 +14,14 @@ call collective:
 * the potential with fixed-potential electrodes, branch currents, R_eq, Joule heat per element;
 * the heat step by the theta method with fixed temperatures and convection.
 
+The 'voronoi' law's faces need a tessellation, wider than the pairs: its shares are carved
+by :func:`carve_region_share` from the rank's *region* (its own elements and a halo around
+them), on which the rank's law object tessellates, once per region; the factors and the cell
+volumes (the heat capacities) of the owned elements come from there.
+
 What it does not do (yet) raises :class:`~yade_electro.core.errors.BoundaryConditionError`
-when the engine is built: the 'voronoi' law (its tessellation is global), surface and wall
-electrodes, current-driven electrodes, per-material tables, heat fluxes, sources and walls.
+when the engine is built: surface and wall electrodes, current-driven electrodes,
+per-material tables, heat fluxes, sources and walls.
 
 Units: SI (m, ohm m, S, V, A, W, K, J/K, W/K, s).
 """
@@ -37,10 +42,13 @@ from ..network.distributed import PartitionedConduction, PartitionedHeat
 from ..network.partition import LocalNetwork, split_network
 from ..solvers.partitioned import GhostExchange, mpi_comm, summed
 
-__all__ = ["Share", "carve_share", "DistributedElectroThermal", "Held", "Exchange", "DISTRIBUTED_LAWS"]
+__all__ = ["Share", "carve_share", "carve_region_share", "DistributedElectroThermal", "Held", "Exchange",
+           "DISTRIBUTED_LAWS", "REGION_LAWS"]
 
 #: the laws a distributed run computes
-DISTRIBUTED_LAWS = ("continuum", "contact", "liggghts", "pipe")
+DISTRIBUTED_LAWS = ("continuum", "contact", "liggghts", "pipe", "voronoi")
+#: the laws whose shares are carved from a region with a halo (:func:`carve_region_share`)
+REGION_LAWS = ("voronoi",)
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +59,11 @@ class Share:
 
     graph: Optional[ContactGraph]
     network: LocalNetwork
+    #: the geometric factors [m] of the edges when the carving computed them (the 'voronoi'
+    #: law, on the rank's region), else None (computed on the share)
+    factor: Optional[np.ndarray] = None
+    #: the owned elements' cell volumes [m^3] when the law has cells ('voronoi'), else None
+    volume: Optional[np.ndarray] = None
 
     @property
     def n_owned(self) -> int:
@@ -70,20 +83,42 @@ class Share:
         return Share(graph, LocalNetwork(net.owned_key, net.ghost_key, net.ghost_owner, graph.edges))
 
 
+def _carve(graph, owner, rank):
+    owner = np.asarray(owner, dtype=np.int64)
+    network, held = split_network(graph.n_nodes, graph.edges, owner, rank, keys=graph.ids)
+    if network.n_owned == 0:
+        return Share(None, network), held, None
+    nodes = np.concatenate([np.flatnonzero(owner == rank), graph.index_of(network.ghost_key)])
+    sub = ContactGraph(graph.pos[nodes], graph.radius[nodes], network.edges, ids=graph.ids[nodes],
+                       revision=graph.revision)
+    return Share(sub, LocalNetwork(network.owned_key, network.ghost_key, network.ghost_owner, sub.edges)), held, nodes
+
+
 def carve_share(graph: Optional[ContactGraph], owner, rank: int) -> Share:
     """The share of rank ``rank`` of a graph of the elements it has (the whole packing, or its
     own and mirrored ones), ``owner[i]`` the rank owning node i. The share's edges are the
     graph's edges with an owned end, in the graph's order."""
     if graph is None:
         return Share(None, LocalNetwork([], [], [], np.zeros((0, 2), np.int64)))
-    owner = np.asarray(owner, dtype=np.int64)
-    network, held = split_network(graph.n_nodes, graph.edges, owner, rank, keys=graph.ids)
-    if network.n_owned == 0:
-        return Share(None, network)
-    nodes = np.concatenate([np.flatnonzero(owner == rank), graph.index_of(network.ghost_key)])
-    sub = ContactGraph(graph.pos[nodes], graph.radius[nodes], network.edges, ids=graph.ids[nodes],
-                       revision=graph.revision)
-    return Share(sub, LocalNetwork(network.owned_key, network.ghost_key, network.ghost_owner, sub.edges))
+    return _carve(graph, owner, rank)[0]
+
+
+def carve_region_share(graph: Optional[ContactGraph], owner, rank: int, law) -> Share:
+    """The share of rank ``rank`` for a law whose network and factors need a neighbourhood
+    wider than the pairs (the 'voronoi' law: a tessellation): ``graph`` is the rank's region
+    (the elements it owns and a halo around them, with their bonds), ``law`` the rank's law
+    object, which keeps the region's tessellation. The share's edges are the law's conducting
+    pairs with an owned end; its ``factor`` and ``volume`` are the region's values, exact for
+    the owned elements when the halo holds every element their cells and crack rule see."""
+    if graph is None:
+        return carve_share(None, None, rank)
+    pairs = np.asarray(law.network(graph), dtype=np.int64).reshape(-1, 2)
+    factor = law.factor(graph, pairs)
+    share, held, nodes = _carve(graph.with_edges(pairs), owner, rank)
+    if share.graph is None:
+        return share
+    volume = law.cell_volumes(graph)[nodes[:share.n_owned]] if hasattr(law, "cell_volumes") else None
+    return Share(share.graph, share.network, factor=np.asarray(factor, float)[held], volume=volume)
 
 
 @dataclass(frozen=True)
@@ -136,7 +171,13 @@ class DistributedElectroThermal:
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
             raise BoundaryConditionError(f"a distributed run computes the laws {', '.join(DISTRIBUTED_LAWS)}; law "
-                                         f"{law!r} is not one of them (the 'voronoi' law's tessellation is global)")
+                                         f"{law!r} is not one of them")
+        if law in REGION_LAWS:
+            for item in convection:
+                if item.area is None:
+                    raise BoundaryConditionError(
+                        f"convection {item.name!r} with the {law!r} law needs a scalar area= [m^2] in a distributed "
+                        "run (the exposed area there is the continuum model's)")
         self.material, self.law_name = material, law
         self.law = make_law(law, **dict(law_params or {}))
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
@@ -178,6 +219,9 @@ class DistributedElectroThermal:
             return np.zeros(0)
         if is_contact_law(self.law_name):
             return self.law.factor(g, g.edges)
+        if self.law_name in REGION_LAWS:
+            raise ValueError(f"the {self.law_name!r} law's shares are carved with carve_region_share (they carry "
+                             "their factors)")
         S = transmission_surface(g, threshold=self.law.threshold, factor=self.law.factor_)
         S = exchange.local(S[:share.n_owned])
         return np.sqrt(S[g.edges[:, 0]] * S[g.edges[:, 1]]) / edge_lengths(g, g.edges)
@@ -186,6 +230,8 @@ class DistributedElectroThermal:
         g, n, m = share.graph, share.n_owned, self.material
         if g is None:
             return np.zeros(0)
+        if share.volume is not None and self.volume_fraction is None:     # cells that fill the solid
+            return m.density * m.specific_heat * share.volume
         fv = volume_fraction(g)[:n] if self.volume_fraction is None else self.volume_fraction
         return m.density * m.specific_heat * g.volume[:n] / fv
 
@@ -266,7 +312,7 @@ class DistributedElectroThermal:
         """One call on ``share`` (a new element set or edge set rebuilds the solves, else the
         values are refreshed in place): the potential, the Joule heat, and a heat step of
         ``dt`` [s] (None or 0: no heat step). Returns the totals of all ranks."""
-        factor = None
+        factor = share.factor
         if is_contact_law(self.law_name) and share.graph is not None:   # pair factors: once, on all contacts
             factor = self.law.factor(share.graph, share.graph.edges)
             touching = factor > 0

@@ -28,12 +28,15 @@ import numpy as np
 
 from ..core.errors import BoundaryConditionError
 from ..core.materials import Material
-from ..physics.distributed import DISTRIBUTED_LAWS, DistributedElectroThermal, Exchange, Held, carve_share
+from ..core.selection import check_selector
+from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedElectroThermal, Exchange, Held,
+                                   carve_region_share, carve_share)
+from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
-from .scene import ensure_thermal_state, write_body_attribute
+from .scene import bulk_coordinates, ensure_thermal_state, write_body_attribute
 
 __all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls",
-           "PETSC_SOLVERS"]
+           "PETSC_SOLVERS", "Slabs", "slab_region", "chosen_ids"]
 
 #: the solver names of a distributed run, and the preconditioner each takes
 PETSC_SOLVERS = {"petsc": "deflation", "petsc-hypre": "hypre", "petsc-gamg": "gamg"}
@@ -80,6 +83,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
     conditions."""
     if materials is not None:
         _refuse("per-material tables (Materials): give one Material")
+    comm = mpi_comm()
     if law not in DISTRIBUTED_LAWS:
         _refuse(f"the {law!r} law (it does {', '.join(DISTRIBUTED_LAWS)})")
     if walls:
@@ -118,7 +122,148 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
                                      volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
-                                     max_substeps=h.get("max_substeps", 100000), preconditioner=PETSC_SOLVERS[solver])
+                                     max_substeps=h.get("max_substeps", 100000), preconditioner=PETSC_SOLVERS[solver],
+                                     comm=comm)
+
+
+class Slabs:
+    """Plain mpiexec: this rank's slab and the region it reads.
+
+    Ownership: equal counts of spheres in slabs along the packing's longest axis, fixed by
+    body id when a sphere is first seen (every rank sees every sphere's position then: the
+    region is chosen from all of them; spheres added later go by position).
+
+    Region (:meth:`region`, the readers' ``keep`` hook): the spheres this rank owns and every
+    sphere within ``halo`` [m] of one of them, so a rank holds its slab and a layer around it,
+    not the scene. The halo is the reach of an element's share (its contacts and bonds: two
+    largest diameters; with the 'voronoi' law, whose cells and crack rule look farther,
+    ``hops + 2`` of them) plus a margin of one largest diameter. The region is kept by id until
+    some body has moved by half the margin since it was made (:meth:`check`; not with the
+    'voronoi' law, whose faces are those of the first configuration), or spheres appear. A
+    bond or interaction that leaves the region from an owned element means the halo was too
+    thin: :meth:`read` doubles it and reads again (three times at most, then an error).
+
+    Parameters
+    ----------
+    rank, size : this rank and the number of ranks
+    hops : None, or the 'voronoi' law's hops (its wider reach, and no move check)
+    """
+
+    def __init__(self, rank: int, size: int, hops: Optional[int] = None):
+        self.rank, self.size, self.hops = int(rank), int(size), hops
+        self.axis, self._bounds, self._owner_by_id = None, None, np.zeros(0, np.int64)
+        #: the halo [m], how often the region was made, the whole packing's (r_min, r_max) [m]
+        self.halo, self.builds, self.radius_range = None, 0, None
+        self._ids, self._seen, self._coords, self._margin, self._scale = None, None, None, 0.0, 1.0
+
+    def owner(self, ids, pos) -> np.ndarray:
+        """The owner of each sphere (see the class doc)."""
+        if self._bounds is None:
+            self.axis = int(np.argmax(np.ptp(pos, axis=0)))
+            x = np.sort(pos[:, self.axis])
+            self._bounds = x[(np.arange(1, self.size) * x.shape[0]) // self.size]
+        known = self._owner_by_id                         # owner by body id, -1: not seen yet
+        if known.shape[0] <= int(ids.max()):
+            known = self._owner_by_id = np.concatenate([known, np.full(int(ids.max()) + 1 - known.shape[0], -1)])
+        owner = known[ids]
+        new = owner < 0
+        owner[new] = np.searchsorted(self._bounds, pos[new, self.axis], side="right")
+        known[ids[new]] = owner[new]
+        return owner
+
+    def region(self, ids, pos, radius) -> np.ndarray:
+        """Which of the spheres (all of the scene's) this rank reads (see the class doc)."""
+        from scipy.spatial import cKDTree
+        owner = self.owner(ids, pos)
+        if self._ids is not None and np.all(np.isin(ids, self._seen)):
+            return np.isin(ids, self._ids)
+        own = owner == self.rank
+        d = 2.0 * float(np.max(radius))
+        reach = 2.0 * d if self.hops is None else max(2.0 * d, (int(self.hops) + 2) * d)
+        self._margin = d
+        self.halo = self._scale * (reach + self._margin)
+        keep = own.copy()
+        if own.any() and (~own).any():
+            dist, _ = cKDTree(pos[own]).query(pos[~own], distance_upper_bound=self.halo)
+            keep[~own] = np.isfinite(dist)
+        self._ids, self._seen = ids[keep], ids.copy()
+        self.radius_range = (float(np.min(radius)), float(np.max(radius)))
+        self._coords = bulk_coordinates()
+        self.builds += 1
+        return keep
+
+    def forget(self):
+        """Make the region again at the next full read."""
+        self._ids = None
+
+    def check(self, reader):
+        """A new region (and a full read) when some body moved by more than half the margin
+        since the region was made: two bodies could then have closed the margin between them."""
+        if self._coords is None or self.hops is not None:
+            return
+        now = bulk_coordinates()
+        if now.shape != self._coords.shape or np.max(
+                np.abs(now - self._coords).sum(axis=1), initial=0.0) > 0.5 * self._margin:
+            self.forget()
+            reader.invalidate()
+
+    def read(self, reader):
+        """The region's graph from ``reader`` (see the class doc)."""
+        for _ in range(4):
+            graph = reader.read()
+            cut = getattr(reader, "cut_nodes", np.zeros(0, np.int64))
+            if not cut.size or not np.any(self.owner(graph.ids[cut], graph.pos[cut]) == self.rank):
+                return graph
+            self._scale *= 2.0
+            self.forget()
+            reader.invalidate()
+        raise BoundaryConditionError(f"rank {self.rank}: owned elements keep interactions with elements beyond a halo "
+                                     f"of {self.halo:.3g} m; their bonds reach farther than the packing's diameters")
+
+
+def slab_region(law: str, law_params: Optional[dict]) -> Optional[Slabs]:
+    """The :class:`Slabs` of a distributed engine under plain mpiexec (None under yade.mpy),
+    made before its first read so that no rank reads the whole scene."""
+    if in_mpy_subdomain():
+        return None
+    hops = int((law_params or {}).get("hops") or 3) if law in REGION_LAWS else None
+    return Slabs(world_rank(), world_size(), hops)
+
+
+def chosen_ids(comm, graph, selects: Optional[dict], what: str = "electrode") -> dict:
+    """Body ids each selection (name -> ids or a predicate ``f(pos, radius) -> mask``) chose in
+    the whole scene, when each rank read only a part of it (``graph``): each rank selects on
+    its part, the ranks join their choices (collective, so every rank raises the same error):
+    ids that are no sphere of the scene, or a selection that chose nothing, raise
+    BoundaryConditionError."""
+    out = {}
+    for name in sorted(selects or {}):
+        sel, label = selects[name], f"{what} {name!r}"
+        check_selector(sel, label)
+        asked = None
+        if callable(sel):
+            mask = np.asarray(sel(graph.pos, graph.radius), dtype=bool)
+            if mask.shape != (graph.n_nodes,):
+                raise BoundaryConditionError(f"{label}: the selector returned shape {mask.shape}, expected a mask of "
+                                             f"({graph.n_nodes},)")
+            mine = graph.ids[mask]
+        else:
+            asked = np.atleast_1d(np.asarray(sel))
+            if asked.dtype == bool:
+                raise BoundaryConditionError(f"{label}: a boolean mask cannot select in a distributed run (each rank "
+                                             "reads a part of the scene); give body ids or a predicate f(pos, radius)")
+            asked = asked.astype(np.int64)
+            mine = asked[np.isin(asked, graph.ids)]
+        ids = np.unique(np.concatenate(comm.allgather(np.asarray(mine, np.int64))))
+        if asked is not None and ids.size < np.unique(asked).size:
+            missing = np.setdiff1d(asked, ids)
+            raise BoundaryConditionError(f"{label}: ids not in the packing: {missing[:10].tolist()} (ids must be "
+                                         "spherical bodies of the packing)")
+        if ids.size == 0:
+            raise BoundaryConditionError(f"{label} selects no element: check its region/ids against the packing "
+                                         "(selection is by element centre)")
+        out[name] = ids
+    return out
 
 
 class DistributedCalls:
@@ -132,18 +277,25 @@ class DistributedCalls:
     write_back : body attribute of the potential (None: not written)
     temperatures : write the temperatures to ``b.state.temp``
     thermal_dt, time_scale : the thermal step of a call (fixed, or the elapsed O.time scaled)
+    slabs : the Slabs the reader's first read used (plain mpiexec), or None
+    graph : that first read's graph: the 'voronoi' law's faces are made on it, as a serial
+        engine makes them when it is built (the reference configuration)
     """
 
     def __init__(self, O, reader, model: DistributedElectroThermal, write_back: Optional[str] = None,
-                 temperatures: bool = False, thermal_dt: Optional[float] = None, time_scale: float = 1.0):
+                 temperatures: bool = False, thermal_dt: Optional[float] = None, time_scale: float = 1.0,
+                 slabs: Optional[Slabs] = None, graph=None):
         self.O, self.reader, self.model = O, reader, model
         self.write_back, self.temperatures = write_back, temperatures
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
         self.rank = model.comm.Get_rank()
         self.size = model.comm.Get_size()
-        self._slab_axis, self._bounds, self._owner_by_id = None, None, np.zeros(0, np.int64)
+        self.slabs = slabs
         self._last_time = float(O.time)
         self.share = None
+        if slabs is not None and graph is not None and model.law_name in REGION_LAWS:
+            model.law.radius_range = slabs.radius_range
+            model.law.faces(graph)
 
     @property
     def mode(self) -> str:
@@ -161,18 +313,7 @@ class DistributedCalls:
             for i in np.flatnonzero(owner < 0):          # seen but in no list: ask the body
                 owner[i] = int(self.O.bodies[int(graph.ids[i])].subdomain)
             return owner
-        if self._bounds is None:                           # equal slabs along the longest axis
-            self._slab_axis = int(np.argmax(np.ptp(graph.pos, axis=0)))
-            x = np.sort(graph.pos[:, self._slab_axis])
-            self._bounds = x[(np.arange(1, self.size) * x.shape[0]) // self.size]
-        known = self._owner_by_id                         # owner by body id, -1: not seen yet
-        if known.shape[0] <= int(graph.ids.max()):
-            known = self._owner_by_id = np.concatenate([known, np.full(int(graph.ids.max()) + 1 - known.shape[0], -1)])
-        owner = known[graph.ids]
-        new = owner < 0
-        owner[new] = np.searchsorted(self._bounds, graph.pos[new, self._slab_axis], side="right")
-        known[graph.ids[new]] = owner[new]
-        return owner
+        return self.slabs.owner(graph.ids, graph.pos)
 
     def abort(self, exc: BaseException):
         """End every rank after this one failed (the others would wait for it forever): the
@@ -191,8 +332,28 @@ class DistributedCalls:
             # yade.mpy erases and re-inserts mirrored bodies when it collides: what the reader
             # counts to detect a change does not see that, so a full read each call
             self.reader.invalidate()
-        graph = None if master else self.reader.read()
-        share = carve_share(graph, self._owner(graph) if graph is not None else None, self.rank)
+            if self.slabs is not None:
+                self.slabs.forget()
+        region_law = self.model.law_name in REGION_LAWS
+        if self.mode == "mpy":
+            if region_law:
+                raise BoundaryConditionError(f"the {self.model.law_name!r} law runs distributed under plain mpiexec "
+                                             "only (its tessellation needs a halo wider than yade.mpy's mirrors)")
+            self.reader.region = None                  # the workers read what YADE gave them
+            graph = None if master else self.reader.read()
+        else:
+            if self.slabs is None:                     # built where the first read was not a region's
+                self.slabs = Slabs(self.rank, self.size, getattr(self.model.law, "hops", None) if region_law else None)
+            if self.reader.region is None:
+                self.reader.region = self.slabs.region
+                self.reader.invalidate()
+            self.slabs.check(self.reader)
+            graph = self.slabs.read(self.reader)
+            if region_law:                             # the whole packing's band and tolerances
+                self.model.law.radius_range = self.slabs.radius_range
+        owner = self._owner(graph) if graph is not None else None
+        share = (carve_region_share(graph, owner, self.rank, self.model.law) if region_law
+                 else carve_share(graph, owner, self.rank))
         self.share = share
         now = float(self.O.time)
         dt = self.thermal_dt if self.thermal_dt is not None else (now - self._last_time) * self.time_scale

@@ -43,7 +43,8 @@ from . import registry
 from .granular import check_wall_bodies
 from .scene import write_body_attribute
 
-from .distributed import DistributedCalls, distributed_model
+from ..solvers.partitioned import mpi_comm
+from .distributed import DistributedCalls, chosen_ids, distributed_model
 from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
 from .options import Electrode, Output, Reader, electrical_settings
 __all__ = ["ElectricalEngine"]
@@ -220,11 +221,16 @@ class ElectricalEngine(EngineBase):
         self.model.update(graph)
 
     def _electrode_ids(self, graph) -> dict:
-        """Body ids each selected electrode chose on ``graph`` (surface and wall electrodes have none)."""
+        """Body ids each selected electrode chose in the scene, every rank having read its part
+        ``graph`` (collective; surface and wall electrodes have none)."""
         if self.model is None:
             return {}
         chosen = {s.name for s in self.model.specs if s.surface is None and not s.wall}
-        return {name: graph.ids[m.nodes(graph)] for name, m in self.model.memberships.items() if name in chosen}
+        ids = chosen_ids(mpi_comm(), graph, {name: m.select for name, m in self.model.memberships.items()
+                                             if name in chosen})
+        for name, v in ids.items():                  # kept by id, as a serial engine keeps them
+            self.model.memberships[name].restore(v)
+        return ids
 
     def _distributed_calls(self, graph):
         ids = self._electrode_ids(graph)
@@ -232,7 +238,8 @@ class ElectricalEngine(EngineBase):
                                   materials=self._materials_config, law=self._options["law"],
                                   law_params=self._law_params, electrodes=self.model.specs, electrode_ids=ids,
                                   walls=self._declared_walls)
-        return DistributedCalls(self.O, self.reader, model, write_back=self.write_back)
+        return DistributedCalls(self.O, self.reader, model, write_back=self.write_back, slabs=self._slabs,
+                                graph=graph)
 
     def _material_base(self):
         return {"resistivity": self._resistivity}

@@ -21,7 +21,7 @@ from ..core.materials import real_number
 from . import persistence
 from . import registry
 from .runtime import MPY_REFUSAL, import_yade, in_mpy_subdomain
-from .distributed import PETSC_SOLVERS, distributed_requested, world_rank
+from .distributed import PETSC_SOLVERS, distributed_requested, slab_region, world_rank
 from .granular import GranularReader
 from .scene import SceneReader, check_write_back, predicate_selector
 
@@ -244,10 +244,15 @@ class EngineBase:
 
     def _finish(self, history_mode):
         """After the model is built: first read, checks, history, runner, saved config."""
+        distributed = distributed_requested(self._distributed_solver())
+        self._slabs = slab_region(self._options["law"], self._law_params) if distributed else None
+        if self._slabs is not None:                 # plain mpiexec: no rank reads the whole scene
+            self.reader.region = self._slabs.region
+            self.reader.invalidate()
         graph = self.reader.read()                  # no spheres: GraphError here, in the script
         check_write_back(self.write_back, self.reader.bodies)
         self._distributed = None
-        if distributed_requested(self._distributed_solver()):
+        if distributed:
             if self._resume is not None:
                 raise RuntimeError(f"engine {self.label!r}: a distributed run does not continue a saved one yet")
             self._distributed = self._distributed_calls(graph)     # its errors here, in the script

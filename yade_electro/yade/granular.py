@@ -211,6 +211,9 @@ class GranularReader:
         self._wall_contacts: Dict[str, tuple] = {}
         self.periodic = False
         self.accepts_periodic = bool(periodic)
+        #: ``keep(ids, pos, radius) -> mask``: read only the spheres of a region (see
+        #: :func:`~yade_electro.yade.scene.read_spheres`); None: all
+        self.region = None
 
     # -- public --------------------------------------------------------------------------
     def read(self) -> ContactGraph:
@@ -303,7 +306,7 @@ class GranularReader:
         return None
 
     def _full_read(self):
-        spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic)
+        spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic, keep=self.region)
         self.periodic = bool(self.O.periodic)
         if self.periodic and self.walls:
             raise GraphError(f"walls ({sorted(self.walls)}) in a periodic cell are not supported: a sphere meets a "

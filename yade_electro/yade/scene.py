@@ -56,7 +56,7 @@ import logging
 import operator
 from collections import Counter, deque
 from itertools import repeat
-from typing import Dict, List, NamedTuple, Optional
+from typing import List, NamedTuple, Optional
 
 import numpy as np
 
@@ -91,7 +91,7 @@ class SphereBodies(NamedTuple):
     pos: np.ndarray            # (n, 3) centres [m]
     radius: np.ndarray         # (n,) radii [m], finite and > 0
     bodies: List               # the YADE bodies
-    slot_of: Dict[int, int]    # body id -> row of every existing body in YADE's bulk readers
+    slot_of: "SlotMap"         # body id -> row of every existing body in YADE's bulk readers
     node_slot: np.ndarray      # (n,) row of each sphere in the bulk readers
     ignored: Counter           # what was left out, by reason
 
@@ -105,15 +105,40 @@ PERIODIC_REFUSAL = (
     "packing in a box without periodicity, or cut a piece out of the periodic packing")
 
 
-def read_spheres(O, mask: Optional[int] = None, periodic: bool = False) -> SphereBodies:
+class SlotMap:
+    """Body id -> row of YADE's bulk readers, for every existing body (a sorted id array
+    searched, not a dict: a few bytes per body)."""
+
+    def __init__(self, existing):
+        self.ids = np.asarray(existing, dtype=np.int64)
+
+    def __len__(self) -> int:
+        return int(self.ids.shape[0])
+
+    def __getitem__(self, bid) -> int:
+        k = int(np.searchsorted(self.ids, int(bid)))
+        if k >= self.ids.shape[0] or self.ids[k] != int(bid):
+            raise KeyError(bid)
+        return k
+
+    def rows(self, ids) -> np.ndarray:
+        """The rows of ``ids`` (all existing)."""
+        return np.searchsorted(self.ids, np.asarray(ids, dtype=np.int64))
+
+
+def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=None) -> SphereBodies:
     """Every body whose shape is a ``Sphere`` (not a clump or clump member, and with ``b.mask &
     mask`` when a mask is given), by a Python loop over ``O.bodies``. GraphError when there is
     none, a radius is not finite and > 0, or the scene is periodic and the caller does not
-    take ``periodic`` cells (:data:`PERIODIC_REFUSAL`)."""
+    take ``periodic`` cells (:data:`PERIODIC_REFUSAL`).
+
+    ``keep``: a region, ``keep(ids, pos, radius) -> mask`` over every sphere; only the spheres
+    it keeps are read (their YADE bodies fetched by id), so what is held grows with the
+    region, not the scene (a distributed run's rank reads its slab and a halo)."""
     if O.periodic and not periodic:
         raise GraphError(PERIODIC_REFUSAL)
     Sphere = import_yade().Sphere
-    ids, pos, rad, bodies, existing = [], [], [], [], []
+    ids, xyz, rad, bodies, existing = array.array("q"), array.array("d"), array.array("d"), [], array.array("q")
     ignored = Counter()
     for b in O.bodies:
         if b is None:
@@ -130,22 +155,27 @@ def read_spheres(O, mask: Optional[int] = None, periodic: bool = False) -> Spher
             continue
         p = b.state.pos
         ids.append(b.id)
-        pos.append((p[0], p[1], p[2]))
+        xyz.extend((p[0], p[1], p[2]))
         rad.append(b.shape.radius)
-        bodies.append(b)
+        if keep is None:
+            bodies.append(b)
     if not ids:
         raise GraphError("the simulation has no spherical bodies to conduct through "
                          f"(bodies: {len(O.bodies)}, left out: {dict(ignored) or 'none'}); "
                          "add spheres, or check the mask")
-    ids = np.asarray(ids, dtype=np.int64)
-    rad = np.asarray(rad, dtype=float)
+    ids = np.frombuffer(ids, dtype=np.int64).copy()
+    pos = np.frombuffer(xyz, dtype=float).reshape(-1, 3).copy()
+    rad = np.frombuffer(rad, dtype=float).copy()
     bad = ~(np.isfinite(rad) & (rad > 0))
     if np.any(bad):
         raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
                          f"{rad[bad][:5].tolist()}")
-    slot = {bid: k for k, bid in enumerate(existing)}
-    return SphereBodies(ids, np.asarray(pos, dtype=float), rad, bodies, slot,
-                        np.array([slot[int(i)] for i in ids], dtype=np.int64), ignored)
+    if keep is not None:
+        chosen = np.asarray(keep(ids, pos, rad), dtype=bool)
+        ids, pos, rad = ids[chosen], pos[chosen], rad[chosen]
+        bodies = [O.bodies[i] for i in ids.tolist()]
+    slot = SlotMap(np.frombuffer(existing, dtype=np.int64))
+    return SphereBodies(ids, pos, rad, bodies, slot, slot.rows(ids), ignored)
 
 
 def warn_left_out(ignored: Counter, before: Counter) -> None:
@@ -159,10 +189,10 @@ def warn_left_out(ignored: Counter, before: Counter) -> None:
                     "leave the clumps out of the mask on purpose", n)
 
 
-def bulk_coordinates(n_existing: int) -> np.ndarray:
+def bulk_coordinates(n_existing: Optional[int] = None) -> np.ndarray:
     """Centres (n_existing, 3) [m] of every existing body, by YADE's C++ bulk reader
     ``utils.coordsAndDisplacements`` (rows as ``SphereBodies.slot_of``); GraphError when the
-    body count is no longer ``n_existing``.
+    body count is no longer ``n_existing`` (None: not checked).
 
     The lists of Python floats go to numpy through ``array.array('d', ...)``, about 10 % of the
     read faster than ``numpy.fromiter`` (``bench/bench_live.py``'s ``live_positions_read``
@@ -170,7 +200,7 @@ def bulk_coordinates(n_existing: int) -> np.ndarray:
     calls alone 0.62 and 3.0 ms)."""
     U = import_yade().utils
     cols = [U.coordsAndDisplacements(k)[0] for k in range(3)]
-    if len(cols[0]) != n_existing:
+    if n_existing is not None and len(cols[0]) != n_existing:
         raise GraphError("the number of bodies changed since the last full read (call invalidate())")
     return np.column_stack([np.frombuffer(array.array("d", c)) for c in cols])
 
@@ -269,6 +299,12 @@ class SceneReader:
         self._probe = None
         self._jcfpm = []
         self._node_slot = None
+        #: ``keep(ids, pos, radius) -> mask``: read only the spheres of a region (see
+        #: :func:`read_spheres`); None: all
+        self.region = None
+        #: after a full read with a region: the nodes with a real interaction to a sphere
+        #: outside it (its halo was too thin if one of them needs all its neighbours)
+        self.cut_nodes = np.zeros(0, np.int64)
 
     # -- the one public call -------------------------------------------------------------
     def read(self) -> ContactGraph:
@@ -343,16 +379,16 @@ class SceneReader:
 
     def _full_read(self):
         O = self.O
-        spheres = read_spheres(O, self.mask)
+        spheres = read_spheres(O, self.mask, keep=self.region)
         ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
         index = {int(i): k for k, i in enumerate(ids)}
-        edges, phys, flags = [], [], []
+        edges, phys, flags, cut = [], [], [], []
         flag_of_type = {}
         for inter in O.interactions:
             if not inter.isReal:
                 continue
             a, b = index.get(inter.id1), index.get(inter.id2)
-            if a is None or b is None:
+            if a is None and b is None:
                 continue
             ph = inter.phys
             t = type(ph)
@@ -362,12 +398,16 @@ class SceneReader:
             if self.bonds == "cohesive":
                 if flag is None or not flag(ph):
                     continue
+            if a is None or b is None:                        # an edge leaving the region
+                cut.append(a if a is not None else b)
+                continue
             edges.append((a, b))
             phys.append(ph)
             flags.append(flag if self.bonds == "cohesive" else None)
         self._revision += 1
         self.graph = ContactGraph(spheres.pos, rad, np.asarray(edges, dtype=np.int64).reshape(-1, 2), ids,
                                   self._revision)
+        self.cut_nodes = np.unique(np.asarray(cut, dtype=np.int64))
         self._bodies, self._phys, self._flags = bodies, phys, flags
         # every bond of one phys type: read its flag attribute directly
         self._uniform = None
