@@ -215,6 +215,7 @@ def worker(kinds, sizes, repeat, cache_dir):
                     x, info = ps.solve(rows.fixed_rhs(c2[held], v), x0=x)
                     comm.Barrier()
                     best2, it2 = min(best2, time.perf_counter() - t), info["iterations"]
+                    ps.destroy()                         # petsc4py 3.18 frees parallel objects only so
                 row[name] = {"cold_s": best, "iterations": it, "resolve_s": best2, "resolve_iterations": it2}
             row["loadavg"] = os.getloadavg()[0]
             if rank == 0:

@@ -26,11 +26,16 @@ def _serial_reduced(n, edges, c, fixed, value, diag):
     return L[free][:, free].toarray(), -(L[free][:, np.flatnonzero(fixed)] @ value[fixed])
 
 
-def test_stacked_rows_of_every_rank_are_the_serial_reduced_matrix():
+@pytest.mark.parametrize("native", [True, False])
+def test_stacked_rows_of_every_rank_are_the_serial_reduced_matrix(native, monkeypatch):
+    if not native:                                      # the pattern without the compiled helper
+        import yade_electro.native as N
+        monkeypatch.setattr(N, "csr_pattern", lambda *a: None)
     g = cubic_lattice((4, 3, 9), r=1.0)
+    edges = g.edges
     n = g.n_nodes
     rng = np.random.default_rng(0)
-    c = rng.uniform(0.5, 2.0, g.n_edges)
+    c = rng.uniform(0.5, 2.0, edges.shape[0])
     diag = rng.uniform(0, 0.1, n)
     fixed = np.zeros(n, bool)
     fixed[:12] = fixed[-12:] = True
@@ -42,14 +47,14 @@ def test_stacked_rows_of_every_rank_are_the_serial_reduced_matrix():
     number[order] = np.arange(order.shape[0])
     A_rows, r_rows = [], []
     for rank in range(3):
-        share, held = split_network(n, g.edges, owner, rank)
+        share, held = split_network(n, edges, owner, rank)
         local_nodes = np.concatenate([np.flatnonzero(owner == rank), share.ghost_key])
         rows = OwnedRows(share, number[local_nodes])
         data = rows.values(c[held], diag[np.flatnonzero(owner == rank)])
         A_rows.append(sp.csr_matrix((data, rows.indices, rows.indptr), shape=(rows.n_rows, order.shape[0])))
         r_rows.append(rows.fixed_rhs(c[held], value[local_nodes]))
     A = sp.vstack(A_rows).toarray()
-    A_ser, r_ser = _serial_reduced(n, g.edges, c, fixed, value, diag)
+    A_ser, r_ser = _serial_reduced(n, edges, c, fixed, value, diag)
     # serial rows are in node order of the free nodes; ours in global-number order
     free = np.flatnonzero(~fixed)
     perm = np.searchsorted(free, order)                 # serial row of each global number

@@ -157,6 +157,10 @@ class PartitionedConduction:
     def network(self) -> LocalNetwork:
         return self._share.network
 
+    def close(self):
+        """Free the solver's PETSc objects (collective); the object is not usable after."""
+        self._share.system.destroy()
+
     def update_conductance(self, conductance):
         """New edge conductances [S], same edges (collective); the setup is kept."""
         s = self._share
@@ -256,6 +260,10 @@ class PartitionedHeat:
     @property
     def network(self) -> LocalNetwork:
         return self._share.network
+
+    def close(self):
+        """Free the solver's PETSc objects (collective); the object is not usable after."""
+        self._share.system.destroy()
 
     def update_conductance(self, conductance):
         """New edge conductances [W/K], same edges (collective)."""

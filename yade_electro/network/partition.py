@@ -1,4 +1,5 @@
-"""One rank's share of a network, and the rows of the reduced system it owns (numpy only).
+"""One rank's share of a network, and the rows of the reduced system it owns (numpy; the
+compiled CSR pattern of :mod:`yade_electro.native` when it is built).
 
 A distributed run splits the elements between ranks: each rank *owns* some nodes and sees,
 as *ghosts*, the nodes of other ranks its own nodes are joined to. :class:`LocalNetwork`
@@ -27,6 +28,24 @@ import numpy as np
 from ..core.errors import GraphError
 
 __all__ = ["LocalNetwork", "OwnedRows", "split_network"]
+
+
+def _pattern(rows, cols, n_rows: int, n_cols: int):
+    """(indptr, indices, slot) of the CSR pattern of the (row, col) pairs, columns sorted in
+    each row, ``slot`` the position of each pair in the data (repeated pairs share one): the
+    compiled counting sort (:func:`yade_electro.native.csr_pattern`) for distinct pairs, else
+    one sorted int64 key per pair."""
+    from ..native import NativeError, csr_pattern
+    try:
+        got = csr_pattern(rows, cols, (n_rows, n_cols)) if rows.size else None
+    except NativeError:
+        got = None
+    if got is not None:
+        return got
+    uniq, slot = np.unique(rows * n_cols + cols, return_inverse=True)
+    ur = uniq // n_cols
+    return (np.concatenate([[0], np.cumsum(np.bincount(ur, minlength=n_rows))]), uniq - ur * n_cols,
+            slot.reshape(-1))
 
 
 def _ro(a, dtype):
@@ -147,25 +166,34 @@ class OwnedRows:
         self.row_of = np.full(network.n_local, -1, np.int64)
         self.row_of[self.free_owned] = np.arange(self.n_rows)
         e = network.edges
-        rows, cols, self._parts = [], [], []
-        # diagonal: every owned free node has its entry (an isolated one too: d may hold it)
-        rows.append(np.arange(self.n_rows))
-        cols.append(own_u)
+        # per direction (a, b): edges whose a-end is an owned unknown, whether their b-end is
+        # free (an off-diagonal entry) or fixed (the right-hand side); masks and the small
+        # fixed parts are kept, the rows are gathered again when values are made (a few
+        # bytes per edge kept, not tens: 63 MB at 630k edges before)
+        self._on, self._free, self._fixed = [], [], []
+        rows, cols = [np.arange(self.n_rows)], [own_u]
         for a, b in ((0, 1), (1, 0)):
             ra = self.row_of[e[:, a]]
-            on = ra >= 0                           # the a-end is an owned unknown
-            free_b = on & (u[e[:, b]] >= 0)
-            self._parts.append((np.flatnonzero(on), ra[on], np.flatnonzero(free_b), ra[free_b],
-                                np.flatnonzero(on & (u[e[:, b]] < 0)), ra[on & (u[e[:, b]] < 0)],
-                                e[on & (u[e[:, b]] < 0), b]))
+            on = ra >= 0
+            ub = u[e[:, b]]
+            free_b = on & (ub >= 0)
+            fixed_b = np.flatnonzero(on & (ub < 0))
+            self._on.append(on)
+            self._free.append(free_b)
+            self._fixed.append((fixed_b, ra[fixed_b], e[fixed_b, b]))
             rows.append(ra[free_b])
-            cols.append(u[e[free_b, b]])
+            cols.append(ub[free_b])
+            del ra, ub
         r, c = np.concatenate(rows), np.concatenate(cols)
+        del rows, cols
         width = max(int(u.max()) + 1 if u.size else 1, 1)     # > every column number
-        uniq, self._slot = np.unique(r * width + c, return_inverse=True)
-        ur = uniq // width
-        self.indices = _ro(uniq - ur * width, np.int64)
-        self.indptr = _ro(np.concatenate([[0], np.cumsum(np.bincount(ur, minlength=self.n_rows))]), np.int64)
+        indptr, indices, slot = _pattern(r, c, self.n_rows, width)
+        small = width < 2 ** 31 - 1 and indices.size < 2 ** 31 - 1     # 32-bit indices: half the memory
+        self.indices = _ro(indices, np.int32 if small else np.int64)
+        self.indptr = _ro(indptr, np.int32 if small else np.int64)
+        self._slot = slot.astype(np.int32) if small else slot
+        #: the position in the values of each row's diagonal entry
+        self.diagonal_index = _ro(self._slot[:self.n_rows], np.int64)
 
     @property
     def nnz(self) -> int:
@@ -181,10 +209,11 @@ class OwnedRows:
         d = np.zeros(self.n_rows)
         if diagonal is not None:
             d += np.asarray(diagonal, dtype=float)[self.free_owned]
-        for on, ra, *_ in self._parts:
-            d += np.bincount(ra, c[on], self.n_rows)
-        entries = [d] + [-c[p[2]] for p in self._parts]
-        return np.bincount(self._slot, np.concatenate(entries), self.nnz)
+        e = self.network.edges
+        for a, on in enumerate(self._on):
+            d += np.bincount(self.row_of[e[on, a]], c[on], self.n_rows)
+        entries = np.concatenate([d] + [-c[free] for free in self._free])
+        return np.bincount(self._slot, entries, self.nnz)
 
     def fixed_rhs(self, conductance, value) -> np.ndarray:
         """``r_i = sum_j c_ij v_j`` over the fixed neighbours j of each owned unknown i, for the
@@ -192,6 +221,6 @@ class OwnedRows:
         c = np.asarray(conductance, dtype=float)
         v = np.asarray(value, dtype=float)
         r = np.zeros(self.n_rows)
-        for *_, fe, fr, fnode in self._parts:
+        for fe, fr, fnode in self._fixed:
             r += np.bincount(fr, c[fe] * v[fnode], self.n_rows)
         return r

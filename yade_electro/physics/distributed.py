@@ -253,6 +253,10 @@ class DistributedElectroThermal:
         of the elements kept (by id); ``factor``: the share's geometric factors when the caller
         has them."""
         self.share = share
+        for old in (self.conduction, self.heat):     # every rank prepares: free the old solvers together
+            if old is not None:
+                old.close()
+        self.conduction = self.heat = None
         net = share.network
         exchange = GhostExchange(net, self.comm)
         self._exchange = exchange

@@ -158,8 +158,19 @@ class PETScSolver(Solver):
         return ((ip - a).astype(self.PETSc.IntType), A.indices[a:z].astype(self.PETSc.IntType),
                 np.ascontiguousarray(A.data[a:z], dtype=self.PETSc.ScalarType))
 
+    def _release(self):
+        """Free the PETSc objects of the last setup (every rank sets up together): petsc4py
+        3.18 defers freeing objects of COMM_WORLD when Python drops them (measured: 10 MB kept
+        per setup at 200k unknowns)."""
+        for name in ("_ksp", "_M", "_x", "_b", "_scatter", "_xall"):
+            obj = getattr(self, name, None)
+            if obj is not None:
+                obj.destroy()
+                setattr(self, name, None)
+
     def _setup(self, A):
         PETSc = self.PETSc
+        self._release()
         n = A.shape[0]
         self._Acsr = A if sp.isspmatrix_csr(A) else sp.csr_matrix(A)
         self._Acsr.sort_indices()

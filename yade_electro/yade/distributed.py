@@ -33,7 +33,7 @@ from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedEle
                                    carve_region_share, carve_share)
 from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
-from .scene import bulk_coordinates, ensure_thermal_state, write_body_attribute
+from .scene import ensure_thermal_state, write_body_attribute
 
 __all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls",
            "PETSC_SOLVERS", "Slabs", "slab_region", "chosen_ids"]
@@ -138,10 +138,10 @@ class Slabs:
     not the scene. The halo is the reach of an element's share (its contacts and bonds: two
     largest diameters; with the 'voronoi' law, whose cells and crack rule look farther,
     ``hops + 2`` of them) plus a margin of one largest diameter. The region is kept by id until
-    some body has moved by half the margin since it was made (:meth:`check`; not with the
-    'voronoi' law, whose faces are those of the first configuration), or spheres appear. A
-    bond or interaction that leaves the region from an owned element means the halo was too
-    thin: :meth:`read` doubles it and reads again (three times at most, then an error).
+    some body has moved by half the margin since it was made (a granular reader's contacts;
+    not with the 'voronoi' law, whose faces are those of the first configuration), or spheres
+    appear. A bond or interaction that leaves the region from an owned element means the halo
+    was too thin: :meth:`read` doubles it and reads again (three times at most, then an error).
 
     Parameters
     ----------
@@ -155,6 +155,7 @@ class Slabs:
         #: the halo [m], how often the region was made, the whole packing's (r_min, r_max) [m]
         self.halo, self.builds, self.radius_range = None, 0, None
         self._ids, self._seen, self._coords, self._margin, self._scale = None, None, None, 0.0, 1.0
+        self._fresh = False
 
     def owner(self, ids, pos) -> np.ndarray:
         """The owner of each sphere (see the class doc)."""
@@ -188,7 +189,7 @@ class Slabs:
             keep[~own] = np.isfinite(dist)
         self._ids, self._seen = ids[keep], ids.copy()
         self.radius_range = (float(np.min(radius)), float(np.max(radius)))
-        self._coords = bulk_coordinates()
+        self._coords, self._fresh = None, True           # the positions then: the reader's, after it
         self.builds += 1
         return keep
 
@@ -196,21 +197,31 @@ class Slabs:
         """Make the region again at the next full read."""
         self._ids = None
 
-    def check(self, reader):
-        """A new region (and a full read) when some body moved by more than half the margin
-        since the region was made: two bodies could then have closed the margin between them."""
-        if self._coords is None or self.hops is not None:
-            return
-        now = bulk_coordinates()
-        if now.shape != self._coords.shape or np.max(
-                np.abs(now - self._coords).sum(axis=1), initial=0.0) > 0.5 * self._margin:
-            self.forget()
-            reader.invalidate()
+    def _moved(self, coords) -> bool:
+        """Has some body moved by more than half the margin since the region was made (two
+        bodies could then have closed the margin between them)?"""
+        if self._coords is None or coords is None:
+            return False
+        return coords.shape != self._coords.shape or bool(np.max(
+            np.abs(coords - self._coords).sum(axis=1), initial=0.0) > 0.5 * self._margin)
 
     def read(self, reader):
-        """The region's graph from ``reader`` (see the class doc)."""
+        """The region's graph from ``reader`` (see the class doc). A granular reader's
+        contacts come from the positions: when a body has moved too far since the region was
+        made (checked on the positions of every body the reader reads anyway), the region is
+        made again and read again. A bonded reader's edges are YADE's interactions: a new one
+        makes it read again, and one that leaves the region from an owned element means the
+        halo was too thin."""
         for _ in range(4):
             graph = reader.read()
+            coords = getattr(reader, "last_coordinates", None)
+            if self._fresh:
+                self._coords, self._fresh = coords, False
+            elif self.hops is None and self._moved(coords):
+                self.forget()
+                reader.invalidate()
+                graph = reader.read()
+                self._coords, self._fresh = getattr(reader, "last_coordinates", None), False
             cut = getattr(reader, "cut_nodes", np.zeros(0, np.int64))
             if not cut.size or not np.any(self.owner(graph.ids[cut], graph.pos[cut]) == self.rank):
                 return graph
@@ -347,7 +358,6 @@ class DistributedCalls:
             if self.reader.region is None:
                 self.reader.region = self.slabs.region
                 self.reader.invalidate()
-            self.slabs.check(self.reader)
             graph = self.slabs.read(self.reader)
             if region_law:                             # the whole packing's band and tolerances
                 self.model.law.radius_range = self.slabs.radius_range

@@ -214,6 +214,8 @@ class GranularReader:
         #: ``keep(ids, pos, radius) -> mask``: read only the spheres of a region (see
         #: :func:`~yade_electro.yade.scene.read_spheres`); None: all
         self.region = None
+        #: the centres [m] of every existing body at the last capture (YADE's bulk reader)
+        self.last_coordinates = None
 
     # -- public --------------------------------------------------------------------------
     def read(self) -> ContactGraph:
@@ -230,6 +232,7 @@ class GranularReader:
         if reason:
             self._full_read()
         coords = bulk_coordinates(self._n_existing)
+        self.last_coordinates = coords
         pos = coords[self._node_slot]
         if not np.all(np.isfinite(pos)):
             bad = self.graph.ids[~np.all(np.isfinite(pos), axis=1)]
