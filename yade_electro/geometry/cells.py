@@ -103,7 +103,7 @@ def _protrusion_integral(verts, count, centre, container, signed=True):
 
 
 def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
-                  planes_per_round: int = 2, radius_range=None) -> BoundedCells:
+                  planes_per_round: int = 2, radius_range=None, bounds=None) -> BoundedCells:
     """Voronoi cells of the element centres bounded by the container: faces, volumes and
     boundary faces, from one tessellation (see the module doc for the ghosts).
 
@@ -123,10 +123,10 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     solid away (a re-entrant corner) is not used: such a cell is measured by sampling
     (:func:`_sampled_volume`, faces by :func:`_clipped_area`) and has no boundary faces.
 
-    ``radius_range``: (r_min, r_max) [m] of the whole packing when ``pos`` is a part of it
-    (a distributed rank's region): the ghosts' band (4 r_max) and the clipping tolerance
-    (``rel_tol`` 2 r_min) are then the whole packing's, so the part's inner cells are the
-    whole's. Default: those of ``radius``.
+    ``radius_range`` (r_min, r_max) and ``bounds`` (lo, hi) [m]: those of the whole packing
+    when ``pos`` is a part of it (a distributed rank's region): the ghosts' band (4 r_max),
+    the clipping tolerance (``rel_tol`` 2 r_min) and the far points are then the whole
+    packing's, so the part's inner cells are the whole's. Default: those of ``pos``.
 
     Returns
     -------
@@ -138,7 +138,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     n = pos.shape[0]
     r_min, r_max = (float(np.min(radius)), float(np.max(radius))) if radius_range is None else map(float, radius_range)
     ghosts, _, _, _ = ghost_points(pos, radius, container, band=4.0 * r_max)
-    pts, tess = tessellate_with_ghosts(pos, radius, ghosts)
+    pts, tess = tessellate_with_ghosts(pos, radius, ghosts, bounds, r_max)
     n_real_and_ghosts = n + ghosts.shape[0]
     rp = tess.ridge_points
     tol0 = rel_tol * 2.0 * r_min

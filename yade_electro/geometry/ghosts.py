@@ -50,12 +50,15 @@ def ghost_points(pos, radius, container=None, band=None, neighbour_barycentre=No
     return ghosts, foot, nrm, near
 
 
-def tessellate_with_ghosts(pos, radius, ghosts):
+def tessellate_with_ghosts(pos, radius, ghosts, bounds=None, r_max=None):
     """Voronoi tessellation of the elements, their ghosts and eight far points (which keep
     every cell of a real element finite). Returns (all points, :class:`Tessellation` with the
-    faces of the elements: with each other and with ghosts)."""
-    lo, hi = pos.min(axis=0), pos.max(axis=0)
-    span = max(float(np.max(hi - lo)), float(np.max(radius)) * 4)
+    faces of the elements: with each other and with ghosts). ``bounds`` (lo, hi) [m] and
+    ``r_max`` [m]: those of the whole packing when ``pos`` is a part of it (the far points,
+    which bound a cell left open, are then the whole's); default: those of ``pos``."""
+    lo, hi = (pos.min(axis=0), pos.max(axis=0)) if bounds is None else (np.asarray(bounds[0], float),
+                                                                         np.asarray(bounds[1], float))
+    span = max(float(np.max(hi - lo)), float(np.max(radius) if r_max is None else r_max) * 4)
     mid = 0.5 * (lo + hi)
     far = mid + 10.0 * span * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
     pts = np.concatenate([pos, ghosts, far])

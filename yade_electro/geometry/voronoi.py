@@ -107,10 +107,11 @@ class VoronoiFaces:
         self.extent = None if extent is None else np.asarray(extent)[order]
 
     @classmethod
-    def of(cls, graph, container, radius_range=None):
+    def of(cls, graph, container, radius_range=None, bounds=None):
         """Faces of ``graph``'s elements in ``container``, from :func:`bounded_cells` (kept,
-        with the cell volumes and boundary faces of the same pass; ``radius_range`` as there)."""
-        cells = bounded_cells(graph.pos, graph.radius, container, radius_range=radius_range)
+        with the cell volumes and boundary faces of the same pass; ``radius_range`` and
+        ``bounds`` as there)."""
+        cells = bounded_cells(graph.pos, graph.radius, container, radius_range=radius_range, bounds=bounds)
         faces = cls(cells.pairs, cells.area, graph.n_nodes, cells.face_centre, cells.face_extent)
         faces.cells = cells
         return faces

@@ -378,7 +378,8 @@ class VoronoiLaw(ConductanceLaw):
     name = "voronoi"
     needs_container = True
 
-    def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets", radius_range=None):
+    def __init__(self, container=None, hops: int = 3, reference=None, crack: str = "facets", radius_range=None,
+                 bounds=None):
         if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
             raise ValueError("the 'voronoi' law needs container=<the solid's shape>, an object with sdf(x) "
                              "and gradient(x) (e.g. yade_electro.geometry.shapes.as_shape(predicate)); "
@@ -397,6 +398,8 @@ class VoronoiLaw(ConductanceLaw):
         #: (r_min, r_max) [m] of the whole packing when the graphs are a part of it (a
         #: distributed rank's region; see :func:`~yade_electro.geometry.cells.bounded_cells`)
         self.radius_range = None if radius_range is None else (float(radius_range[0]), float(radius_range[1]))
+        #: (lo, hi) [m] of the whole packing's centres, likewise
+        self.bounds = bounds
         #: how often the faces' areas were looked up for an edge list (once per list)
         self.area_lookups = 0
 
@@ -413,7 +416,7 @@ class VoronoiLaw(ConductanceLaw):
                 base = ContactGraph(ref[1], ref[2], bonds, ref[0])
             else:
                 base = graph
-            self._faces = VoronoiFaces.of(base, self.container, self.radius_range)
+            self._faces = VoronoiFaces.of(base, self.container, self.radius_range, self.bounds)
             self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius), np.array(base.edges))
             self._key = key
             self.tessellations += 1

@@ -152,8 +152,9 @@ class Slabs:
     def __init__(self, rank: int, size: int, hops: Optional[int] = None):
         self.rank, self.size, self.hops = int(rank), int(size), hops
         self.axis, self._bounds, self._owner_by_id = None, None, np.zeros(0, np.int64)
-        #: the halo [m], how often the region was made, the whole packing's (r_min, r_max) [m]
-        self.halo, self.builds, self.radius_range = None, 0, None
+        #: the halo [m], how often the region was made, the whole packing's (r_min, r_max)
+        #: and (lo, hi) of its centres [m]
+        self.halo, self.builds, self.radius_range, self.bounds = None, 0, None, None
         self._ids, self._seen, self._coords, self._margin, self._scale = None, None, None, 0.0, 1.0
         self._fresh = False
 
@@ -189,6 +190,7 @@ class Slabs:
             keep[~own] = np.isfinite(dist)
         self._ids, self._seen = ids[keep], ids.copy()
         self.radius_range = (float(np.min(radius)), float(np.max(radius)))
+        self.bounds = (pos.min(axis=0), pos.max(axis=0))
         self._coords, self._fresh = None, True           # the positions then: the reader's, after it
         self.builds += 1
         return keep
@@ -305,7 +307,7 @@ class DistributedCalls:
         self._last_time = float(O.time)
         self.share = None
         if slabs is not None and graph is not None and model.law_name in REGION_LAWS:
-            model.law.radius_range = slabs.radius_range
+            model.law.radius_range, model.law.bounds = slabs.radius_range, slabs.bounds
             model.law.faces(graph)
 
     @property
@@ -360,7 +362,7 @@ class DistributedCalls:
                 self.reader.invalidate()
             graph = self.slabs.read(self.reader)
             if region_law:                             # the whole packing's band and tolerances
-                self.model.law.radius_range = self.slabs.radius_range
+                self.model.law.radius_range, self.model.law.bounds = self.slabs.radius_range, self.slabs.bounds
         owner = self._owner(graph) if graph is not None else None
         share = (carve_region_share(graph, owner, self.rank, self.model.law) if region_law
                  else carve_share(graph, owner, self.rank))
