@@ -5,10 +5,13 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
 
 ``rod``
     A bonded rod (rod_resistance's, R = 1 mm, L = 5 mm, 304L, rho_e(T) with beta = 1e-3 1/K)
+    with the 'voronoi' law (each rank tessellates only its region: its slab and a halo),
     Joule-heated between its end layers (1 V), the bottom layer held at 293 K, backward Euler,
     ``--calls`` calls. Plain mpiexec: every rank runs the whole (static) scene and owns a slab.
     The serial engine (``solver='direct'``) runs on the same scene, call by call, beside the
     distributed one: the reference is exact and on the same geometry.
+``rod-continuum``
+    The same with the continuum law.
 ``bed``
     A granular bed settling on a floor under gravity (hexagonal lattice, contact law), Joule-
     heated between its two ends, one end at 293 K, Crank-Nicolson, serial engine beside the
@@ -16,9 +19,11 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
 ``pin``
     The pin torsion test (pin_torsion's pin, rig and kept calibration), twisted 20 times the
     paper's rate until 0.12 rad or separation, with its continuum-law engine (end element
-    layers; its other engine, the 'voronoi' law with surface electrodes, is not distributed:
-    the tessellation is global) serial and distributed side by side: bonds break, each rank's
-    share loses edges, the solves are rebuilt collectively. Plain mpiexec.
+    layers) serial and distributed side by side: bonds break, each rank's share loses edges,
+    the solves are rebuilt collectively. Plain mpiexec.
+``pin-voronoi``
+    The same with the 'voronoi' law and crack facets (the broken bonds' facets cut the faces
+    across them), on the same end layers (surface electrodes are not distributed).
 ``heat``
     Heat only on the bed (HeatEngine, made distributed by ``Integrator(solver='petsc')``): one end
     at 350 K, convection to 280 K at the other, forward Euler with sub-steps. Plain mpiexec.

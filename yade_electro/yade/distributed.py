@@ -10,8 +10,10 @@ Two ways to run, one user script:
   built work wherever their elements end up.
 * **Plain mpiexec** (every rank runs the whole scene, as YADE does without ``mpy``): each rank
   owns a slab of the packing along its longest axis (equal counts, fixed by body id at the
-  first call; bodies added later go by position). The mechanics are YADE's, replicated; the
-  network is not: each rank builds, holds and solves only its share.
+  first read; bodies added later go by position) and reads only its *region*, the slab and a
+  halo around it (:class:`Slabs`), from the engine's first read on. The mechanics are YADE's,
+  replicated; the network is not: each rank reads, builds, holds and solves only its share.
+  The 'voronoi' law runs here only: each rank tessellates its region.
 
 Each call: read the scene, carve this rank's share (:func:`~yade_electro.physics.distributed.carve_share`),
 advance :class:`~yade_electro.physics.distributed.DistributedElectroThermal` (collective),
