@@ -253,7 +253,9 @@ def _crossing(kind, n, it, unknowns, t_ours_cold, amg, t_amg_cold, **extra):
 
 def extrapolate(rows):
     """The serial rows' extrapolation (see :func:`_crossing`), and that of the partitioned
-    rows of each rank count (our deflation against the faster of BoomerAMG and GAMG cold)."""
+    rows of each rank count (our deflation with the smoother the engines take for the system,
+    Jacobi for the voronoi rod and ICC for the others, against the faster of BoomerAMG and GAMG
+    cold)."""
     out = []
     for kind in sorted({r["system"] for r in rows if r["part"] == "serial"}):
         rr = sorted((r for r in rows if r["part"] == "serial" and r["system"] == kind), key=lambda r: r["unknowns"])
@@ -271,9 +273,10 @@ def extrapolate(rows):
             continue
         big = rr[-1]
         amg = min(("hypre", "gamg"), key=lambda k: big[k]["cold_s"])
+        ours = "deflation_jacobi" if kind == "voronoi" else "deflation"
         out.append(_crossing(kind, np.array([r["unknowns"] for r in rr], float),
-                             np.array([r["deflation"]["iterations"] for r in rr], float), big["unknowns"],
-                             big["deflation"]["cold_s"], amg, big[amg]["cold_s"], ranks=P))
+                             np.array([r[ours]["iterations"] for r in rr], float), big["unknowns"],
+                             big[ours]["cold_s"], amg, big[amg]["cold_s"], ranks=P, ours=ours))
     return out
 
 

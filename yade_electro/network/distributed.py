@@ -67,7 +67,7 @@ class _Share:
     """What both physics set up on a share: the ghost exchange, the unknowns, the rows."""
 
     def __init__(self, network: LocalNetwork, fixed_owned, comm, preconditioner, rtol, pos, spacing, options,
-                 exchange: Optional[GhostExchange] = None):
+                 exchange: Optional[GhostExchange] = None, smoother: str = "icc"):
         self.network = network
         self.comm = mpi_comm(comm)
         self.exchange = GhostExchange(network, self.comm) if exchange is None else exchange
@@ -80,7 +80,8 @@ class _Share:
         if preconditioner == "deflation" and coords is None:
             raise ValueError("preconditioner='deflation' needs pos= (the owned nodes' positions, m) and spacing=")
         self.system = PartitionedSystem(self.rows, self.n_global, self.comm, preconditioner=preconditioner,
-                                        rtol=rtol, coords=coords, spacing=spacing, options=options)
+                                        rtol=rtol, coords=coords, spacing=spacing, options=options,
+                                        smoother=smoother)
 
     def edge_values(self, values, error, message: str) -> np.ndarray:
         """``values`` as one finite float >= 0 per edge of the share, else ``error(message)``."""
@@ -103,11 +104,12 @@ class PartitionedConduction:
     comm : mpi4py or petsc4py communicator (default: all ranks)
     preconditioner : 'deflation' (default, needs ``pos`` and ``spacing``), 'hypre', 'gamg', 'jacobi'
     pos : (n_owned, 3) positions [m]; spacing : mean neighbour spacing [m]
+    smoother : the deflation's smoother, 'icc' or 'jacobi' (see PartitionedSystem)
     """
 
     def __init__(self, network: LocalNetwork, conductance, electrode_of, names: Sequence[str], values, *,
                  comm=None, preconditioner: str = "deflation", rtol: float = 1e-10, pos=None,
-                 spacing: Optional[float] = None, options: Optional[dict] = None):
+                 spacing: Optional[float] = None, options: Optional[dict] = None, smoother: str = "icc"):
         self.names = [str(n) for n in names]
         el = np.asarray(electrode_of, dtype=np.int64)
         if el.shape != (network.n_owned,) or (el.size and (el.min() < -1 or el.max() >= len(self.names))):
@@ -132,7 +134,7 @@ class PartitionedConduction:
             if comm.Get_rank() == 0:
                 warnings.warn(floating_message(n_float, heads, "electrode", "a potential of 0 V"), stacklevel=2)
         self._share = _Share(network, (el >= 0) | self.floating, comm, preconditioner, rtol, pos, spacing, options,
-                             exchange=ex)
+                             exchange=ex, smoother=smoother)
         self.electrode_of = el
         self._el_local = ex.local(np.where(self.floating, len(self.names), el))
         self._x = None
@@ -231,12 +233,13 @@ class PartitionedHeat:
     h_area, t_inf : (n_owned,) convection h A [W/K] and ambient temperature [K]; optional
     theta : as :func:`~yade_electro.network.theta.theta_of` (default backward Euler)
     safety, max_substeps : the explicit sub-steps' fraction of the stable step and their limit
+    smoother : the deflation's smoother, 'icc' or 'jacobi' (see PartitionedSystem)
     """
 
     def __init__(self, network: LocalNetwork, capacity, conductance, temperature, *, fixed=None, h_area=None,
                  t_inf=None, theta="backward-euler", comm=None, preconditioner: str = "deflation",
                  rtol: float = 1e-12, pos=None, spacing: Optional[float] = None, options: Optional[dict] = None,
-                 safety: float = 0.9, max_substeps: int = 100000):
+                 safety: float = 0.9, max_substeps: int = 100000, smoother: str = "icc"):
         n = network.n_owned
         self.safety, self.max_substeps, self.substeps = float(safety), int(max_substeps), 0
         C = np.asarray(capacity, dtype=float)
@@ -248,7 +251,7 @@ class PartitionedHeat:
         self.t_inf = np.zeros(n) if t_inf is None else np.asarray(t_inf, dtype=float)
         self.theta = theta_of(theta)
         held = ~np.isnan(self.fixed)
-        self._share = _Share(network, held, comm, preconditioner, rtol, pos, spacing, options)
+        self._share = _Share(network, held, comm, preconditioner, rtol, pos, spacing, options, smoother=smoother)
         self._held = held
         T = np.broadcast_to(np.asarray(temperature, dtype=float), (n,)).copy()
         T[held] = self.fixed[held]

@@ -185,6 +185,11 @@ class DistributedElectroThermal:
         self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
         self.safety, self.max_substeps = float(safety), int(max_substeps)
         self.preconditioner, self.rtol = preconditioner, float(rtol)
+        # the deflation's smoother, by system (bench/bench_peers.py, partitioned lines): ICC
+        # halves the iterations on contact and continuum networks (35-41 against 90-92 at 1M
+        # unknowns) and is the faster; on Voronoi networks (more neighbours, spread
+        # conductances) it saves a third of them and costs more than it saves: Jacobi there
+        self.smoother = "jacobi" if law in REGION_LAWS else "icc"
         self.comm = mpi_comm(comm)
         self._ids: Dict[str, np.ndarray] = {}
         self._T_kept = None              # (sorted ids, their temperatures) of the last share
@@ -273,7 +278,7 @@ class DistributedElectroThermal:
             self.conduction = PartitionedConduction(
                 net, self._conductance(T), el, [e.name for e in self.electrodes],
                 [e.value for e in self.electrodes], comm=self.comm, preconditioner=self.preconditioner,
-                rtol=self.rtol, pos=pos, spacing=spacing)
+                rtol=self.rtol, pos=pos, spacing=spacing, smoother=self.smoother)
         if self.temperature0 is not None:
             fixed = np.full(n, np.nan)
             for item in self.fixed:
@@ -289,7 +294,7 @@ class DistributedElectroThermal:
             self.heat = PartitionedHeat(net, self._capacity(share), self._thermal(), T,
                                         fixed=fixed, h_area=hA, t_inf=t_inf, theta=self.theta, comm=self.comm,
                                         preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing,
-                                        safety=self.safety, max_substeps=self.max_substeps)
+                                        safety=self.safety, max_substeps=self.max_substeps, smoother=self.smoother)
             self.T = self.heat.T
 
     def _spacing(self, share: Share) -> float:
