@@ -110,7 +110,9 @@ class SlotMap:
     searched, not a dict: a few bytes per body)."""
 
     def __init__(self, existing):
-        self.ids = np.asarray(existing, dtype=np.int64)
+        ids = np.asarray(existing, dtype=np.int64)          # YADE's order: by id, so sorted
+        self._order = None if np.all(np.diff(ids) > 0) else np.argsort(ids, kind="stable")
+        self.ids = ids if self._order is None else ids[self._order]
 
     def __len__(self) -> int:
         return int(self.ids.shape[0])
@@ -119,11 +121,12 @@ class SlotMap:
         k = int(np.searchsorted(self.ids, int(bid)))
         if k >= self.ids.shape[0] or self.ids[k] != int(bid):
             raise KeyError(bid)
-        return k
+        return k if self._order is None else int(self._order[k])
 
     def rows(self, ids) -> np.ndarray:
         """The rows of ``ids`` (all existing)."""
-        return np.searchsorted(self.ids, np.asarray(ids, dtype=np.int64))
+        k = np.searchsorted(self.ids, np.asarray(ids, dtype=np.int64))
+        return k if self._order is None else self._order[k]
 
 
 def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=None) -> SphereBodies:
