@@ -25,8 +25,9 @@ the whole graph. This module does the talking:
       block (``smoother='icc'``, default) or the diagonal (``'jacobi'``). Measured side by
       side on the jittered lattice rod at 1M unknowns on 2 ranks (``bench/bench_peers.py``'s
       partitioned lines): ICC took 39 iterations cold and 27 re-solving, against 90 and 64
-      for Jacobi, at about 1.6 times the time per iteration: re-solve 0.53-0.55 s against
-      0.72-0.73 s (GAMG 0.60-0.61 s).
+      for Jacobi, at about 1.6 times the time per iteration: re-solve 0.62 s against 0.79 s
+      (GAMG 0.65 s). On the voronoi rod it saves fewer (24 against 36) and is the slower;
+      the distributed engines take Jacobi there.
   ``'hypre'``
       BoomerAMG with the 3-D options (HMIS coarsening, ext+i interpolation, P_max 4, one
       aggressive level).
@@ -53,7 +54,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..core.errors import SolverError
-from .petsc import HYPRE_3D, check_preconditioner, import_petsc
+from .petsc import HYPRE_3D, check_preconditioner, destroy_attributes, import_petsc
 
 __all__ = ["GhostExchange", "number_unknowns", "PartitionedSystem", "PRECONDITIONERS", "mpi_comm",
            "cluster_labels", "summed"]
@@ -234,10 +235,13 @@ class _DeflationPC:
             raise SolverError(f"the deflation's coarse matrix is singular ({exc}): a part of the network is "
                               "connected to no fixed value") from None
 
+    def _correction(self, w_owned: np.ndarray) -> np.ndarray:
+        """W E^-1 (the ranks' sum of ``w_owned``) on the owned rows (collective)."""
+        return self.factor.solve(summed(self.system.comm, w_owned))[self.labels]
+
     def coarse(self, r_owned: np.ndarray) -> np.ndarray:
         """Q r on the owned rows (collective)."""
-        w = summed(self.system.comm, np.bincount(self.labels, r_owned, self.k))
-        return self.factor.solve(w)[self.labels]
+        return self._correction(np.bincount(self.labels, r_owned, self.k))
 
     def apply(self, pc, x, y):
         """z = y0 + Q (r - A y0), y0 = D^-1 r, with W^T A y0 = (A W)^T y0: one sum over the
@@ -248,9 +252,7 @@ class _DeflationPC:
         else:
             self._local.apply(x, self._yv)
             y0 = self._yv.getArray(readonly=True)
-        w = np.bincount(self.labels, r, self.k) - self.awt @ y0
-        w = summed(self.system.comm, w)
-        y.setArray(y0 + self.factor.solve(w)[self.labels])
+        y.setArray(y0 + self._correction(np.bincount(self.labels, r, self.k) - self.awt @ y0))
 
 
 class PartitionedSystem:
@@ -299,20 +301,12 @@ class PartitionedSystem:
         self.setups, self.setup_time, self._base_iterations = 0, 0.0, None
 
     def destroy(self):
-        """Free PETSc's objects now (collective: every rank calls it). petsc4py 3.18 does not
-        free objects of a parallel communicator when Python drops them (it defers them to a
-        collective clean-up), so a system that is replaced must be destroyed: measured before,
-        every rebuilt system stayed in memory (5-20 MB each at 54k unknowns a rank)."""
-        d = getattr(self, "_deflation", None)
-        if d is not None and d._local is not None:
-            d._local.destroy()
-            d._yv.destroy()
-            d._local = None
-        for name in ("_ksp", "matrix", "_x", "_b", "work"):
-            obj = getattr(self, name, None)
-            if obj is not None:
-                obj.destroy()
-                setattr(self, name, None)
+        """Free PETSc's objects now (collective: every rank calls it; see
+        :func:`~yade_electro.solvers.petsc.destroy_attributes`): a system that is replaced must
+        be, or it stays in memory (measured: 5-20 MB each at 54k unknowns a rank)."""
+        if getattr(self, "_deflation", None) is not None:
+            destroy_attributes(self._deflation, ("_local", "_yv"))
+        destroy_attributes(self, ("_ksp", "matrix", "_x", "_b", "work"))
 
     # -- the matrix --------------------------------------------------------------------------
     def diagonal_of(self, data: np.ndarray) -> np.ndarray:

@@ -245,15 +245,17 @@ def slab_region(law: str, law_params: Optional[dict]) -> Optional[Slabs]:
     return Slabs(world_rank(), world_size(), hops)
 
 
-def chosen_ids(comm, graph, selects: Optional[dict], what: str = "electrode") -> dict:
-    """Body ids each selection (name -> ids or a predicate ``f(pos, radius) -> mask``) chose in
-    the whole scene, when each rank read only a part of it (``graph``): each rank selects on
-    its part, the ranks join their choices (collective, so every rank raises the same error):
-    ids that are no sphere of the scene, or a selection that chose nothing, raise
-    BoundaryConditionError."""
+def chosen_ids(graph, memberships: dict, what: str = "electrode", comm=None) -> dict:
+    """Body ids each membership (name -> :class:`~yade_electro.core.selection.Membership`,
+    selecting by ids or a predicate ``f(pos, radius) -> mask``) chose in the whole scene, when
+    each rank read only a part of it (``graph``): each rank selects on its part, the ranks join
+    their choices (collective, so every rank raises the same error) and each membership is kept
+    by those ids, as a serial engine keeps it. Ids that are no sphere of the scene, or a
+    selection that chose nothing, raise BoundaryConditionError."""
+    comm = mpi_comm(comm)
     out = {}
-    for name in sorted(selects or {}):
-        sel, label = selects[name], f"{what} {name!r}"
+    for name in sorted(memberships):
+        sel, label = memberships[name].select, f"{what} {name!r}"
         check_selector(sel, label)
         asked = None
         if callable(sel):
@@ -278,6 +280,7 @@ def chosen_ids(comm, graph, selects: Optional[dict], what: str = "electrode") ->
             raise BoundaryConditionError(f"{label} selects no element: check its region/ids against the packing "
                                          "(selection is by element centre)")
         out[name] = ids
+        memberships[name].restore(ids)
     return out
 
 

@@ -43,7 +43,6 @@ from . import registry
 from .granular import check_wall_bodies
 from .scene import write_body_attribute
 
-from ..solvers.partitioned import mpi_comm
 from .distributed import DistributedCalls, chosen_ids, distributed_model
 from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
 from .options import Electrode, Output, Reader, electrical_settings
@@ -226,11 +225,7 @@ class ElectricalEngine(EngineBase):
         if self.model is None:
             return {}
         chosen = {s.name for s in self.model.specs if s.surface is None and not s.wall}
-        ids = chosen_ids(mpi_comm(), graph, {name: m.select for name, m in self.model.memberships.items()
-                                             if name in chosen})
-        for name, v in ids.items():                  # kept by id, as a serial engine keeps them
-            self.model.memberships[name].restore(v)
-        return ids
+        return chosen_ids(graph, {name: m for name, m in self.model.memberships.items() if name in chosen})
 
     def _distributed_calls(self, graph):
         ids = self._electrode_ids(graph)

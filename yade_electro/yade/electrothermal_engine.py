@@ -21,7 +21,6 @@ from .runtime import import_yade
 from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
-from ..solvers.partitioned import mpi_comm
 from .distributed import DistributedCalls, chosen_ids, distributed_model
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
@@ -360,12 +359,10 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                                          "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
         specs = self.model.specs if self.model is not None else ()
         ids = self._electrode_ids(graph)
-        cond_ids = chosen_ids(mpi_comm(), graph, {
-            name: m.select for name, m in c.bc_memberships.items()
+        cond_ids = chosen_ids(graph, {
+            name: m for name, m in c.bc_memberships.items()
             if any(b.name == name and getattr(b, "surface", None) is None for b in self._heat_conditions)},
             what="thermal boundary condition")
-        for name, v in cond_ids.items():
-            c.bc_memberships[name].restore(v)
         vf = c.volume_fraction if not callable(c.volume_fraction) else None
         heat = dict(density=t["density"], specific_heat=t["specific_heat"], conductivity=t["conductivity"],
                     temperature=t["temperature"], beta=t["beta"], eta=t["eta"], theta=t["theta"],
