@@ -150,3 +150,48 @@ def test_voronoi_shares_of_regions_are_the_whole_tessellations(ranks):
             assert max(abs(got[k] - want[k]) for k in want) < 1e-11 * scale
             assert np.allclose(share.volume, [vol[i] for i in share.owned_ids.tolist()], rtol=1e-10, atol=0)
         assert law.tessellations == 1                    # faces of the first configuration, kept
+
+
+class _OneRank:
+    """A communicator of one rank (what chosen_ids and the model's checks call)."""
+
+    def allgather(self, x):
+        return [x]
+
+    def Get_rank(self):
+        return 0
+
+    def Get_size(self):
+        return 1
+
+
+def test_selections_on_a_region_are_joined_and_checked():
+    from yade_electro.core.errors import BoundaryConditionError
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.core.selection import Membership
+    from yade_electro.yade.distributed import chosen_ids
+    g = cubic_lattice((3, 3, 4), r=1.0)
+    g = ContactGraph(g.pos, g.radius, g.edges, ids=np.arange(g.n_nodes) * 2 + 10)
+    kept = Membership("top", [10, 12])
+    by_place = Membership("low", lambda p, r: p[:, 2] < 1.0)
+    out = chosen_ids(g, {"top": kept, "low": by_place}, comm=_OneRank())
+    assert out["top"].tolist() == [10, 12] and kept.ids.tolist() == [10, 12]      # kept by id
+    assert by_place.ids.tolist() == out["low"].tolist() and out["low"].size == 9
+    with pytest.raises(BoundaryConditionError, match="ids not in the packing: \\[11\\]"):
+        chosen_ids(g, {"a": Membership("a", [10, 11])}, comm=_OneRank())
+    with pytest.raises(BoundaryConditionError, match="boolean mask cannot select in a distributed run"):
+        chosen_ids(g, {"a": Membership("a", np.ones(g.n_nodes, bool))}, comm=_OneRank())
+    with pytest.raises(BoundaryConditionError, match="selects no element"):
+        chosen_ids(g, {"a": Membership("a", lambda p, r: p[:, 2] > 1e9)}, comm=_OneRank())
+
+
+def test_the_voronoi_law_distributed_refuses_convection_without_an_area():
+    from yade_electro.core.errors import BoundaryConditionError
+    from yade_electro.core.materials import Material
+    from yade_electro.geometry.shapes import Cylinder
+    from yade_electro.physics.distributed import DistributedElectroThermal, Exchange
+    mat = Material(density=1.0, specific_heat=1.0, conductivity=1.0)
+    with pytest.raises(BoundaryConditionError, match="needs a scalar area"):
+        DistributedElectroThermal(mat, "voronoi", {"container": Cylinder((0, 0, 0), (0, 0, 1), 1.0)},
+                                  convection=[Exchange("air", [1], 10.0, 300.0)], temperature=300.0,
+                                  comm=_OneRank())
