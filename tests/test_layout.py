@@ -51,7 +51,7 @@ def test_all_names_exist():
             assert hasattr(mod, name), f"{info.name}.__all__ names {name!r}, which it does not have"
 
 
-@pytest.mark.parametrize("name", ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine"])
+@pytest.mark.parametrize("name", ["ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ThermalExpansion"])
 def test_engines_take_few_documented_keyword_parameters(name):
     from yade_electro import yade as Y
     cls = getattr(Y, name)

@@ -12,9 +12,11 @@ Importing this subpackage does not import YADE by itself; the functions that nee
 from ..core.materials import Material
 from ..laws.law import Law
 from ..network.heat_conditions import Convection, FixedTemperature, HeatFlux, HeatSource
+from ..physics.expansion import AlphaTable
 from ..physics.integrator import Integrator
 from .electrical_engine import ElectricalEngine
 from .electrothermal_engine import ElectroThermalEngine
+from .expansion_engine import ThermalExpansion
 from .heat_engine import HeatEngine
 from .options import (Electrode, InitialTemperature, Materials, Output, Reader, Wall, electrodes_from_dict,
                       walls_from_dict)
@@ -24,10 +26,10 @@ from .scene import SceneReader, ensure_thermal_state, predicate_selector, write_
 
 __all__ = [
     # the engines
-    "ElectricalEngine", "ElectroThermalEngine", "HeatEngine",
+    "ElectricalEngine", "ElectroThermalEngine", "HeatEngine", "ThermalExpansion",
     # their options
     "Material", "Materials", "Electrode", "Wall", "FixedTemperature", "HeatFlux", "Convection", "HeatSource",
-    "InitialTemperature", "Law", "Integrator", "Reader", "Output", "electrodes_from_dict", "walls_from_dict",
+    "InitialTemperature", "AlphaTable", "Law", "Integrator", "Reader", "Output", "electrodes_from_dict", "walls_from_dict",
     # engines in a scene
     "attach", "get_engine", "ENGINES",
     # scene access
