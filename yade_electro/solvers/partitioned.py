@@ -20,14 +20,17 @@ the whole graph. This module does the talking:
       ``A W``, a few entries at most), so an apply costs no product with A and one sum of
       ``k`` values over the ranks. The coarse matrix
       ``E = W^T A W`` (one row per cluster, at most ``max_clusters``) is gathered on every
-      rank and factorised there (sparse LU): a redundant coarse solve, as GAMG does on its
-      coarsest level. The smoother M is block Jacobi with ICC(0) of each rank's diagonal
-      block (``smoother='icc'``, default) or the diagonal (``'jacobi'``). Measured side by
-      side on the jittered lattice rod at 1M unknowns on 2 ranks (``bench/bench_peers.py``'s
-      partitioned lines): ICC took 39 iterations cold and 27 re-solving, against 90 and 64
-      for Jacobi, at about 1.6 times the time per iteration: re-solve 0.62 s against 0.79 s
-      (GAMG 0.65 s). On the voronoi rod it saves fewer (24 against 36) and is the slower;
-      the distributed engines take Jacobi there.
+      rank and factorised there (sparse LU in a symmetric ordering): a redundant coarse
+      solve, as GAMG does on its coarsest level. The smoother M is block Jacobi with ICC(0) of
+      each rank's diagonal block (``smoother='icc'``, default) or the diagonal (``'jacobi'``).
+      Measured side by side on the jittered lattice rod at 1M unknowns on 2 ranks
+      (``bench/bench_peers.py``'s partitioned lines): ICC took 28 iterations cold and 19
+      re-solving, against 62 cold for Jacobi: re-solve 0.57 s against 0.71 s (GAMG 0.55 s).
+      On the voronoi rod it saves fewer (21-27 against 30-36) and is the slower; the
+      distributed engines take Jacobi there. The cluster cap grows with the size
+      (:func:`auto_max_clusters`, 2,000 to 8,000): 8,000 instead of 2,000 took the 1M lattice
+      from 35 to 25 iterations on one rank, cold 2.2 to 1.5 s; 20,000 cut only to 21
+      iterations and made the coarse solve a third of an iteration.
   ``'hypre'``
       BoomerAMG with the 3-D options (HMIS coarsening, ext+i interpolation, P_max 4, one
       aggressive level).
@@ -36,7 +39,8 @@ the whole graph. This module does the talking:
   ``'jacobi'``
       For reference.
 
-  The setup (the AMG hierarchy, the coarse factor) is kept while only values change: the
+  The setup (the AMG hierarchy; the coarse factor and ICC blocks) is kept while only values
+  change (PETSc would refactor the blocks at every change of values otherwise): the
   preconditioner is rebuilt when a solve on it takes more than ``rebuild_factor`` times the
   iterations of the first solve after the last setup (it is stopped there, and goes on from
   its iterate on the new setup).
@@ -57,7 +61,7 @@ from ..core.errors import SolverError
 from .petsc import HYPRE_3D, check_preconditioner, destroy_attributes, import_petsc
 
 __all__ = ["GhostExchange", "number_unknowns", "PartitionedSystem", "PRECONDITIONERS", "mpi_comm",
-           "cluster_labels", "summed"]
+           "cluster_labels", "auto_max_clusters", "summed"]
 
 #: the preconditioners of a partitioned solve
 PRECONDITIONERS = ("deflation", "hypre", "gamg", "jacobi")
@@ -160,8 +164,17 @@ def number_unknowns(exchange: GhostExchange, fixed_owned) -> "tuple[np.ndarray, 
     return exchange.local(own), int(comm.allreduce(n_free))
 
 
+def auto_max_clusters(n_global: int) -> int:
+    """The deflation's default cluster cap: one cluster per 100 unknowns, between 2,000 and
+    8,000. Every rank holds the coarse factor: at 1M unknowns 8,000 clusters (2,000 before)
+    took the lattice rod from 35 to 25 iterations; at 215k unknowns on 2 ranks, 8,000 would
+    add 30-40 MB to each rank (the memory case's ``mem_ratio`` 0.64, against 0.59 with this
+    rule; target 0.6)."""
+    return int(min(8000, max(2000, n_global // 100)))
+
+
 def cluster_labels(pos_owned, comm, spacing: float, cluster_size: float = 3.0,
-                   max_clusters: Optional[int] = 2000) -> "tuple[np.ndarray, int]":
+                   max_clusters: Optional[int] = 8000) -> "tuple[np.ndarray, int]":
     """Cluster of every owned node (piecewise-constant coarse space of the deflation): cells of
     ``cluster_size * spacing`` [m] on the bounding box of all ranks' nodes, grown until at most
     ``max_clusters`` are occupied, numbered by the occupied cells of every rank. Returns the
@@ -211,8 +224,12 @@ class _DeflationPC:
                 lp.setType(PETSc.PC.Type.BJACOBI)
                 lp.setFromOptions()
                 self._local, self._yv = lp, s.matrix.createVecLeft()
+            # PCApply sets a PC up again whenever its matrix's values changed: kept (refactored
+            # only here) as the rest of the setup
+            self._local.setReusePreconditioner(False)
             self._local.setOperators(s.matrix)
             self._local.setUp()
+            self._local.setReusePreconditioner(True)
         k = self.k
         # (A W)^T on the owned rows: W^T A y = (A W)^T y summed over the ranks (A symmetric),
         # so the apply needs no product with A. A W has A's row pattern with the columns'
@@ -230,7 +247,10 @@ class _DeflationPC:
                            (np.concatenate([q[0] for q in parts]), np.concatenate([q[1] for q in parts]))),
                           shape=(k, k)).tocsc()
         try:
-            self.factor = spla.splu(E)
+            # E is SPD: a symmetric ordering and no pivoting (measured at 1M unknowns, 6,912
+            # clusters: a third of COLAMD's fill, solves 4 times faster)
+            self.factor = spla.splu(E, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                                    options={"SymmetricMode": True})
         except RuntimeError as exc:
             raise SolverError(f"the deflation's coarse matrix is singular ({exc}): a part of the network is "
                               "connected to no fixed value") from None
@@ -269,6 +289,8 @@ class PartitionedSystem:
     coords : (n_owned_rows, 3) positions [m] of the owned unknowns ('deflation'), optional
     spacing : float
         Mean neighbour spacing [m] ('deflation': clusters of ``cluster_size`` spacings).
+    max_clusters : int, None or 'auto'
+        The cap on the clusters ('auto': :func:`auto_max_clusters`).
     options : dict of extra PETSc options (prefix ``yep_``), e.g. ``{"pc_gamg_threshold": 0.02}``
     smoother : 'icc' (default) or 'jacobi'
         The deflation's smoother: block Jacobi with an incomplete Cholesky (ICC(0)) of each
@@ -277,7 +299,7 @@ class PartitionedSystem:
 
     def __init__(self, rows, n_global: int, comm, preconditioner: str = "deflation",
                  rtol: float = 1e-10, maxiter: Optional[int] = None, coords=None, spacing: Optional[float] = None,
-                 cluster_size: float = 3.0, max_clusters: Optional[int] = 2000, rebuild_factor: float = 2.0,
+                 cluster_size: float = 3.0, max_clusters="auto", rebuild_factor: float = 2.0,
                  options: Optional[dict] = None, smoother: str = "icc"):
         if preconditioner not in PRECONDITIONERS:
             raise ValueError(f"preconditioner must be one of {', '.join(PRECONDITIONERS)}, got {preconditioner!r}")
@@ -294,6 +316,8 @@ class PartitionedSystem:
         self.rebuild_factor = float(rebuild_factor)
         self.options = dict(options or {})
         self._coords, self._spacing = coords, spacing
+        if max_clusters == "auto":
+            max_clusters = auto_max_clusters(self.n_global)
         self._cluster = (cluster_size, max_clusters)
         self._pcomm = self.PETSc.Comm(comm) if not hasattr(comm, "tompi4py") else comm
         self.matrix = None
