@@ -66,3 +66,10 @@ def test_mpi_petsc(yade_exe, tmp_path):
     # the continuum law between the end layers (3,000 elements): 9.5 % above rho L / (pi R^2); the
     # distributed solve itself is checked against the serial one in tests/test_distributed.py
     assert out["R_eq"] == pytest.approx(0.73e-6 * 5e-3 / (np.pi * 1e-6), rel=0.15)
+
+
+def test_thermal_expansion(run_yade_script):
+    out = run_yade_script(EXAMPLES / "thermal_expansion.py", check=True).result
+    assert out["dT_K"] > 10.0                                          # Joule heating did heat it
+    assert out["strain"] == pytest.approx(out["alpha_dT"], rel=5e-3)    # free rod: strain alpha dT
+    assert abs(out["s_zz_Pa"]) < 1e-4 * 200e9 * out["alpha_dT"] and out["rows"] > 50
