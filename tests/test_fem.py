@@ -254,3 +254,25 @@ def test_cracked_bar_is_a_slit_and_approaches_the_closed_form_from_below():
         fem.edge_crack_increment(2e-3, 8e-3, 2e-3)
     with pytest.raises(fem.MeshError, match="inside the bar"):
         fem.CrackedBarGeometry(crack_depth=3e-3)
+
+
+def test_thermoelastic_closed_forms():
+    """fem.thermoelastic on a box: free expansion strain alpha dT with no stress, the bar held
+    at both ends sigma = -E alpha dT, to round-off (P1 and P2)."""
+    from yade_electro.fem.meshes import box_mesh
+    from yade_electro.fem.thermoelastic import thermal_stress
+    m = box_mesh(1e-3, 1e-3, 4e-3, 0.5e-3, axis=2)
+    E, nu, a = 200e9, 0.3, 1.2e-5
+    T = np.full(m.p.shape[1], 393.0)
+    corner = int(np.argmin(np.sum(m.p ** 2, axis=0)))
+    other = int(np.argmin((m.p[0] - 1e-3) ** 2 + m.p[1] ** 2 + m.p[2] ** 2))
+    pins = ((corner, (0, 1)), (other, (1,)))
+    for order in (1, 2):
+        free = thermal_stress(m, T, 293.0, E, nu, a, {"end0": (2,)}, pins=pins, order=order)
+        assert np.abs(free.stress).max() < 1e-9 * E * a * 100
+        np.testing.assert_allclose(free.displacement_at([[0.5e-3, 0.5e-3, 4e-3]])[0, 2], 4e-3 * a * 100, rtol=1e-9)
+        held = thermal_stress(m, T, 293.0, E, nu, a, {"end0": (2,), "end1": (2,)}, pins=pins, order=order)
+        np.testing.assert_allclose(held.stress[:, 2, 2], -E * a * 100, rtol=1e-9)
+        assert held.mean_stress_where(np.ones(held.stress.shape[0], bool))[0, 0] == pytest.approx(0, abs=1e-6 * E * a)
+    with pytest.raises(Exception, match="nu"):
+        thermal_stress(m, T, 293.0, E, 0.5, a, {"end0": (2,)})

@@ -1,7 +1,7 @@
 """Finite-element reference for the DEM cases (scikit-fem, gmsh meshes).
 
-Solves the same steady conduction, Joule heating and heat conduction problems as the DEM
-model, on the same geometries, with tetrahedral P1/P2 Lagrange elements, so that each DEM
+Solves the same steady conduction, Joule heating, heat conduction and thermo-elastic
+(:mod:`.thermoelastic`) problems as the DEM model, on the same geometries, with tetrahedral P1/P2 Lagrange elements, so that each DEM
 case compares with one function call (:mod:`.references`). It is itself checked against
 closed forms (:mod:`.closed_forms`) and converges under refinement (:mod:`.convergence`);
 see docs/fem.md. Needs scikit-fem (PyPI, pure Python) and, for curved or notched
@@ -18,6 +18,7 @@ from .references import (STEEL_304L, Material, cracked_bar, cracked_bar_referenc
                          plate_potential, plate_reference, rod_joule_heating, rod_reference,
                          rod_resistance, slab_conduction)
 from .thermal import ThermalResult, joule_heating, steady_temperature, transient_conduction
+from .thermoelastic import ThermoElasticResult, thermal_stress
 
 __all__ = [
     "adiabatic_joule_temperature", "bar_resistance", "coax_resistance", "joule_parabola",
@@ -29,5 +30,5 @@ __all__ = [
     "subdomain_average", "STEEL_304L", "Material", "notched_bar", "notched_bar_reference",
     "plate_potential", "plate_reference", "rod_joule_heating", "rod_reference",
     "rod_resistance", "slab_conduction", "ThermalResult", "joule_heating",
-    "steady_temperature", "transient_conduction",
+    "steady_temperature", "transient_conduction", "ThermoElasticResult", "thermal_stress",
 ]
