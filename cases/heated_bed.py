@@ -47,9 +47,11 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(sys.argv[0] if sys.argv and sys.argv[0].endswith("heated_bed.py")
                                        else __file__))
-if os.path.dirname(HERE) not in sys.path:
-    sys.path.insert(0, os.path.dirname(HERE))
+for d in (HERE, os.path.dirname(HERE)):
+    if d not in sys.path:
+        sys.path.insert(0, d)
 
+import thermal_expansion as TE  # noqa: E402
 from yade_electro.geometry.shapes import Box  # noqa: E402
 from yade_electro.packing import dense_packing  # noqa: E402
 
@@ -107,19 +109,10 @@ def pressure(walls):
     return total / 6.0
 
 
-def relax(figure, min_steps=1000, chunk=500, max_steps=60000, rtol=2e-4):
-    """Run until ``figure()`` changed by less than ``rtol`` over each of the last two chunks."""
-    from yade import O
-    O.run(min_steps, True)
-    steps, hist = min_steps, [figure()]
-    while steps < max_steps:
-        O.run(chunk, True)
-        steps += chunk
-        hist.append(figure())
-        if len(hist) >= 3 and all(abs(a - b) <= rtol * max(abs(a), 1e-300) for a, b in zip(hist[-2:], hist[-3:-1])):
-            return steps
-    _say(f"not settled after {max_steps} steps (figure {hist[-1]:.6g})")
-    return steps
+def relax(figure):
+    """Run until ``figure()`` settles (``cases/thermal_expansion.py``'s rule; no unbalanced
+    force test: the walls are held). Returns the steps."""
+    return TE.relax(figure, unbalanced=None)[1]
 
 
 def bulk_modulus(n, cache_dir, wall_friction=0.0):

@@ -167,7 +167,7 @@ def synced_property(name: str, doc: str) -> property:
     return property(get, doc=doc + " With overlap=True, reading it waits for the last call and publishes it.")
 
 
-class EngineBase:
+class EngineBase(registry.RegisteredEngine):
     """What both engines share: configuration, scene reader, runner, history, state tags."""
 
     DEFAULT_LABEL = "electro"
@@ -265,15 +265,7 @@ class EngineBase:
         registry.check_shared_outputs(self)
         if self._resume is not None:
             self._restore_history(self._resume_state)
-        yade = import_yade()
-        self.runner = None
-        for e in self.O.engines:                    # a loaded scene keeps its PyRunner
-            if type(e).__name__ == "PyRunner" and e.label == self.label:
-                self.runner = e
-        if self.runner is None:
-            self.runner = yade.PyRunner(
-                command=f"__import__('yade_electro.yade.registry', fromlist=['run']).run({self.label!r})",
-                iterPeriod=self.iterPeriod, label=self.label)
+        self.runner = self._find_or_make_runner(self.iterPeriod)
         registry.ENGINES[self.label] = self
         self._save_config()
         self._save_state()
@@ -332,14 +324,6 @@ class EngineBase:
     def written_attributes(self) -> tuple:
         return (self.write_back,) if self.write_back else ()
 
-    def remove(self):
-        """Take the engine out of ``O.engines``, the registry and the scene's tags."""
-        self.O.engines = [e for e in self.O.engines if e is not self.runner]
-        if registry.ENGINES.get(self.label) is self:
-            registry.ENGINES.pop(self.label, None)
-        persistence.forget(self.O, self.label)
-        self.removed = True
-
     def _reattach_in_place(self):
         """The scene was replaced (``O.load`` in this process): continue from what it saved."""
         config = persistence.load_config(self.O, self.label)
@@ -350,14 +334,6 @@ class EngineBase:
         kwargs = dict(config["kwargs"])
         registry.ENGINES.pop(self.label, None)
         self._setup(**kwargs, label=self.label, O=self.O, _resume=config)
-
-    @classmethod
-    def resumed(cls, config: dict, label: str, O, overrides: Optional[dict] = None):
-        """The engine ``config`` (what :mod:`.persistence` saved) describes, continuing the saved
-        run on scene ``O``; ``overrides`` replace saved settings (internal names)."""
-        engine = cls.__new__(cls)
-        engine._setup(**{**dict(config["kwargs"]), **dict(overrides or {})}, label=label, O=O, _resume=config)
-        return engine
 
     # -- one call ------------------------------------------------------------------------------
     def step(self):

@@ -24,7 +24,8 @@ finite number >= 0 (or an :class:`~yade_electro.physics.expansion.AlphaTable`), 
 temperature (or ``reference_temperature=`` and a yade-electro heat engine that will write
 them), cohesive bonds in ``'bonds'`` mode. Its configuration and state (the strains already
 applied) are kept in the scene's tags: after ``O.save`` / ``O.load`` it goes on from where it
-was (a new process re-attaches it at its first call).
+was (a new process re-attaches it at its first call). ``remove()`` leaves the strains applied
+so far in the packing.
 
 Units: SI (K, 1/K, m, N, Pa).
 """
@@ -67,7 +68,7 @@ def _is_thermal_engine(e) -> bool:
 
 
 @registry.engine_type
-class ThermalExpansion:
+class ThermalExpansion(registry.RegisteredEngine):
     """Thermal expansion of the spheres of the scene (see the module doc).
 
     Parameters
@@ -152,14 +153,7 @@ class ThermalExpansion:
         self._history = History(history, "a" if _resume is not None else "w")
         if state:                               # rows written after the save are not this run's
             self._history.truncate(int(state.get("rows", len(self._history))))
-        self.runner = None
-        for e in self.O.engines:                # a loaded scene keeps its PyRunner
-            if type(e).__name__ == "PyRunner" and e.label == self.label:
-                self.runner = e
-        if self.runner is None:
-            self.runner = yade.PyRunner(
-                command=f"__import__('yade_electro.yade.registry', fromlist=['run']).run({self.label!r})",
-                iterPeriod=int(iterPeriod), label=self.label)
+        self.runner = self._find_or_make_runner(iterPeriod)
         registry.ENGINES[self.label] = self
         persistence.save_config(self.O, self.label, {"engine": type(self).__name__, "version": 1,
                                                      "kwargs": dict(self._kwargs), "missing": []})
@@ -344,10 +338,11 @@ class ThermalExpansion:
         row = {"iter": int(self.O.iter), "time": float(self.O.time), "T_mean_K": float(T.mean()),
                "strain_mean": float(eps.mean()), "interactions": int(n_bonds)}
         if self._history.path:
-            s = self.element_stress()
+            read = self._interactions()
+            s = self.element_stress(read)
             V = self._volumes()
             mean = np.einsum("n,nij->ij", V, s) / V.sum()
-            fn, _ = self.bond_forces()
+            fn, _ = self.bond_forces(read)
             row.update({f"s_{a}_Pa": float(mean[i, j]) for a, (i, j) in
                         zip(("xx", "yy", "zz", "xy", "yz", "zx"), ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)))})
             row["bond_tension_max_N"] = float(max(fn.max(initial=0.0), 0.0))
@@ -364,8 +359,9 @@ class ThermalExpansion:
 
     # -- read-out -----------------------------------------------------------------------------
     def _interactions(self):
-        """(pairs, contact points, force on the second body [N]) of every real interaction
-        between expanded spheres."""
+        """(positions, pairs, contact points, force on the second body [N]) of every real
+        interaction between expanded spheres: one read of the scene, which the stress and
+        the bond forces share."""
         pairs, pts, force = [], [], []
         index = self._index
         for inter in self.O.interactions:
@@ -379,7 +375,7 @@ class ThermalExpansion:
             pairs.append((a, b))
             pts.append(tuple(inter.geom.contactPoint))
             force.append(tuple(f))
-        return (np.asarray(pairs, np.int64).reshape(-1, 2), np.asarray(pts, float).reshape(-1, 3),
+        return (self._positions(), np.asarray(pairs, np.int64).reshape(-1, 2), np.asarray(pts, float).reshape(-1, 3),
                 np.asarray(force, float).reshape(-1, 3))
 
     def _positions(self):
@@ -393,18 +389,18 @@ class ThermalExpansion:
             r = r * (1.0 + self._eps)
         return 4.0 / 3.0 * np.pi * r ** 3 / self._phi
 
-    def element_stress(self) -> np.ndarray:
+    def element_stress(self, read=None) -> np.ndarray:
         """The Love-Weber stress (n, 3, 3) [Pa] of every expanded sphere now, tension positive
-        (rows as :attr:`ids`)."""
-        pairs, pts, f = self._interactions()
-        return element_stress(self._positions(), pairs, pts, f, self._volumes())
+        (rows as :attr:`ids`). ``read``: what ``_interactions()`` returned, to share one read."""
+        pos, pairs, pts, f = self._interactions() if read is None else read
+        return element_stress(pos, pairs, pts, f, self._volumes())
 
-    def bond_forces(self) -> "tuple[np.ndarray, np.ndarray]":
+    def bond_forces(self, read=None) -> "tuple[np.ndarray, np.ndarray]":
         """(normal force [N], tension positive; shear force magnitude [N]) of every real
         interaction between expanded spheres, and their (m, 2) body ids: returns
-        ``(normal, shear)`` with ``self.last_bond_ids`` set."""
-        pairs, pts, f = self._interactions()
-        pos = self._positions()
+        ``(normal, shear)`` with ``self.last_bond_ids`` set. ``read`` as for
+        :meth:`element_stress`."""
+        pos, pairs, pts, f = self._interactions() if read is None else read
         d = pos[pairs[:, 1]] - pos[pairs[:, 0]]
         n = d / np.linalg.norm(d, axis=1)[:, None]
         fn = np.einsum("mi,mi->m", f, n)
@@ -421,33 +417,18 @@ class ThermalExpansion:
         s_xx ... [Pa], von Mises and mean stress) and ``<prefix>_bonds.vtu`` (normal force,
         tension positive, and shear force [N] per interaction). Returns the two paths."""
         from ..post.vtk import write_bonds, write_elements
-        s = self.element_stress()
-        pos = self._positions()
+        read = self._interactions()
+        s = self.element_stress(read)
+        pos = read[0]
         r = np.array([b.shape.radius for b in self._bodies])
         fields = {"temperature": self._temperatures(), "thermal_strain": self._eps.copy(),
                   "body_id": self._ids.astype(float), "von_mises_Pa": von_mises(s),
                   "mean_stress_Pa": np.trace(s, axis1=1, axis2=2) / 3.0}
         for a, (i, j) in zip(("xx", "yy", "zz", "xy", "yz", "zx"), ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0))):
             fields[f"s_{a}_Pa"] = s[:, i, j]
-        fn, fs = self.bond_forces()
+        fn, fs = self.bond_forces(read)
         pairs = np.searchsorted(self._ids, self.last_bond_ids) if np.all(np.diff(self._ids) > 0) else \
             np.vectorize(self._index.get)(self.last_bond_ids)
         return {"particles": write_elements(f"{prefix}_particles.vtu", pos, r, fields),
                 "bonds": write_bonds(f"{prefix}_bonds.vtu", pos, pairs.reshape(-1, 2),
                                      {"normal_force_N": fn, "shear_force_N": fs})}
-
-    # -- lifecycle ----------------------------------------------------------------------------
-    def remove(self):
-        """Take the engine out of ``O.engines``, the registry and the scene's tags (the strains
-        applied so far stay in the packing)."""
-        self.O.engines = [e for e in self.O.engines if e is not self.runner]
-        if registry.ENGINES.get(self.label) is self:
-            registry.ENGINES.pop(self.label, None)
-        persistence.forget(self.O, self.label)
-        self.removed = True
-
-    @classmethod
-    def resumed(cls, config: dict, label: str, O, overrides: Optional[dict] = None):
-        engine = cls.__new__(cls)
-        engine._setup(**{**dict(config["kwargs"]), **dict(overrides or {})}, label=label, O=O, _resume=config)
-        return engine

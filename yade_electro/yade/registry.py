@@ -30,7 +30,8 @@ from typing import Dict, Optional
 
 from . import persistence
 
-__all__ = ["ENGINES", "get_engine", "run", "attach", "claim_label", "check_shared_outputs", "live_engines",
+__all__ = ["ENGINES", "RegisteredEngine", "get_engine", "run", "attach", "claim_label", "check_shared_outputs",
+           "live_engines",
            "engine_type", "engine_class"]
 
 log = logging.getLogger(__name__)
@@ -40,6 +41,40 @@ ENGINES: Dict[str, object] = {}
 
 #: Engine classes by name, for re-attaching a saved configuration (filled by :func:`engine_type`).
 _ENGINE_TYPES: Dict[str, type] = {}
+
+
+class RegisteredEngine:
+    """What every engine of ours does with YADE's PyRunner, this registry and the scene's tags:
+    its runner (the loaded scene's, or a new one), removal, and re-attaching a saved one. A
+    subclass has ``O``, ``label``, ``runner``, ``removed`` and ``_setup(**kwargs, label, O,
+    _resume)``."""
+
+    def _find_or_make_runner(self, iterPeriod: int):
+        """The PyRunner labelled like the engine that a loaded scene keeps, or a new one that
+        calls :func:`run` every ``iterPeriod`` iterations."""
+        for e in self.O.engines:
+            if type(e).__name__ == "PyRunner" and e.label == self.label:
+                return e
+        from .runtime import import_yade
+        return import_yade().PyRunner(
+            command=f"__import__('yade_electro.yade.registry', fromlist=['run']).run({self.label!r})",
+            iterPeriod=int(iterPeriod), label=self.label)
+
+    def remove(self):
+        """Take the engine out of ``O.engines``, the registry and the scene's tags."""
+        self.O.engines = [e for e in self.O.engines if e is not self.runner]
+        if ENGINES.get(self.label) is self:
+            ENGINES.pop(self.label, None)
+        persistence.forget(self.O, self.label)
+        self.removed = True
+
+    @classmethod
+    def resumed(cls, config: dict, label: str, O, overrides: Optional[dict] = None):
+        """The engine ``config`` (what :mod:`.persistence` saved) describes, continuing the saved
+        run on scene ``O``; ``overrides`` replace saved settings (internal names)."""
+        engine = cls.__new__(cls)
+        engine._setup(**{**dict(config["kwargs"]), **dict(overrides or {})}, label=label, O=O, _resume=config)
+        return engine
 
 
 def engine_type(cls: type) -> type:
