@@ -127,7 +127,7 @@ def main(argv=None):
     dem_elong = elongation()
     lig = np.abs(x0[:, 0] - 0.5 * NJ.LENGTH) < 0.5 * NJ.NOTCH_WIDTH
     s = e.element_stress()
-    V = e._volumes()
+    V = e.element_volumes()
     dem_sigma = np.einsum("n,nij->ij", V[lig], s[lig]) / V[lig].sum()
 
     # FEM: the same rollers and pins (the nodes nearest the two held elements, on x = 0), on

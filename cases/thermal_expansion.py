@@ -186,7 +186,7 @@ def clamped_bar(n, size, E, cache_dir):
     target = -E * ALPHA * DT
     s = e.element_stress()
     mid = np.abs(x0[:, 2] - x0[:, 2].mean()) < (x0[:, 2].max() - x0[:, 2].min()) / 6
-    V = e._volumes()[mid]
+    V = e.element_volumes()[mid]
     lw = float(np.einsum("n,n->", V, s[mid, 2, 2]) / V.sum())
     fn, _ = e.bond_forces()
     return {"check": "clamped_bar", "error_pct": 100 * abs(sigma - target) / abs(target), "sigma_Pa": sigma,

@@ -338,9 +338,9 @@ class ThermalExpansion(registry.RegisteredEngine):
         row = {"iter": int(self.O.iter), "time": float(self.O.time), "T_mean_K": float(T.mean()),
                "strain_mean": float(eps.mean()), "interactions": int(n_bonds)}
         if self._history.path:
-            read = self._interactions()
+            read = self.read_interactions()
             s = self.element_stress(read)
-            V = self._volumes()
+            V = self.element_volumes()
             mean = np.einsum("n,nij->ij", V, s) / V.sum()
             fn, _ = self.bond_forces(read)
             row.update({f"s_{a}_Pa": float(mean[i, j]) for a, (i, j) in
@@ -358,7 +358,7 @@ class ThermalExpansion(registry.RegisteredEngine):
             "calls": self.calls, "rows": len(self._history)})
 
     # -- read-out -----------------------------------------------------------------------------
-    def _interactions(self):
+    def read_interactions(self):
         """(positions, pairs, contact points, force on the second body [N]) of every real
         interaction between expanded spheres: one read of the scene, which the stress and
         the bond forces share."""
@@ -381,7 +381,7 @@ class ThermalExpansion(registry.RegisteredEngine):
     def _positions(self):
         return np.array([tuple(b.state.pos) for b in self._bodies])
 
-    def _volumes(self) -> np.ndarray:
+    def element_volumes(self) -> np.ndarray:
         """Each element's volume [m^3]: its sphere's over the solid fraction at build (cells
         grow with the element in 'radii' mode, as the spheres)."""
         r = np.array([b.shape.radius for b in self._bodies])
@@ -391,16 +391,16 @@ class ThermalExpansion(registry.RegisteredEngine):
 
     def element_stress(self, read=None) -> np.ndarray:
         """The Love-Weber stress (n, 3, 3) [Pa] of every expanded sphere now, tension positive
-        (rows as :attr:`ids`). ``read``: what ``_interactions()`` returned, to share one read."""
-        pos, pairs, pts, f = self._interactions() if read is None else read
-        return element_stress(pos, pairs, pts, f, self._volumes())
+        (rows as :attr:`ids`). ``read``: what :meth:`read_interactions` returned, to share one read."""
+        pos, pairs, pts, f = self.read_interactions() if read is None else read
+        return element_stress(pos, pairs, pts, f, self.element_volumes())
 
     def bond_forces(self, read=None) -> "tuple[np.ndarray, np.ndarray]":
         """(normal force [N], tension positive; shear force magnitude [N]) of every real
         interaction between expanded spheres, and their (m, 2) body ids: returns
         ``(normal, shear)`` with ``self.last_bond_ids`` set. ``read`` as for
         :meth:`element_stress`."""
-        pos, pairs, pts, f = self._interactions() if read is None else read
+        pos, pairs, pts, f = self.read_interactions() if read is None else read
         d = pos[pairs[:, 1]] - pos[pairs[:, 0]]
         n = d / np.linalg.norm(d, axis=1)[:, None]
         fn = np.einsum("mi,mi->m", f, n)
@@ -417,7 +417,7 @@ class ThermalExpansion(registry.RegisteredEngine):
         s_xx ... [Pa], von Mises and mean stress) and ``<prefix>_bonds.vtu`` (normal force,
         tension positive, and shear force [N] per interaction). Returns the two paths."""
         from ..post.vtk import write_bonds, write_elements
-        read = self._interactions()
+        read = self.read_interactions()
         s = self.element_stress(read)
         pos = read[0]
         r = np.array([b.shape.radius for b in self._bodies])
