@@ -16,9 +16,9 @@ shear cohesion ``--strength``), goes through a resistance-heating cycle:
 All three engines run in the YADE loop: ``ElectroThermalEngine`` (voronoi law, a broken bond
 conducts neither current nor heat: crack facets), ``ThermalExpansion`` and YADE's cohesive law,
 which breaks the bonds. The heat runs on its own clock (``Integrator(dt=...)``, one thermal
-step per call) and YADE relaxes ``--steps`` mechanical steps between two calls (quasi-static:
-the history has the unbalanced force). rho_e does not depend on T (``beta = 0``), so R(t)
-shows the cracks alone.
+step per call); after each call YADE relaxes ``--steps`` mechanical steps, and more with the
+engines idle, until the relaxation is quasi-static (see :func:`run`). rho_e does not depend on
+T (``beta = 0``), so R(t) shows the cracks alone.
 
 Figures, per call (the CSV): thermal time, phase, voltage, current, R_eq and the temperatures
 (T_max, the ligament slab's mean, the mean) of the call; then, after the relaxation that follows
