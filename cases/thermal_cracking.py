@@ -49,6 +49,11 @@ Run::
     yade-electro -n -x cases/thermal_cracking.py                  # 5,000 elements
     yade-electro -n -x cases/thermal_cracking.py --quick          # 1,500 elements (the CI test)
     yade-electro -n -x cases/thermal_cracking.py --voltage 0.1    # below the threshold: no crack
+    yade-electro -n -x cases/thermal_cracking.py --clamped --voltage 0.5 --t-heat 0.3 --t-cool 0 --no-pull
+
+With ``--clamped`` both grips hold the bar from the start: the heating itself loads it in
+compression and the bonds break while the current flows (``T_ligament_at_grip_K`` is then the
+end of heating; ``min_ligament_sxx_Pa`` the largest compression).
 
 Ends with one JSON line.
 """
@@ -200,7 +205,7 @@ def pull_strength(n, seed, strength, cache_dir=None, strain=4e-4, steps=20000, e
 
 
 def run(n=5000, seed=1, voltage=0.25, t_heat=0.5, t_cool=1.5, dt=0.01, steps=300, strength=STRENGTH, sense=0.01,
-        tol=0.01, max_extra=10, out_dir="out/thermal_cracking", vtk=True, cache_dir=None):
+        tol=0.01, max_extra=10, clamped=False, out_dir="out/thermal_cracking", vtk=True, cache_dir=None):
     """The heating-gripping-cooling cycle (see the module doc); returns the figures and writes
     the CSV (one row per call) and the VTK snapshots. After each call YADE relaxes ``steps``
     steps, and more (the engines idle) until the free elements' mean |force| is below ``tol``
@@ -226,6 +231,9 @@ def run(n=5000, seed=1, voltage=0.25, t_heat=0.5, t_cool=1.5, dt=0.01, steps=300
         r.initRun = True                # called at the first step of each chunk of ``steps``, then YADE relaxes
     O.engines = O.engines + [engine.runner, expansion.runner]
     crack = _Crack(ids, x0, out_dir if vtk else None)
+    if clamped:                                     # the far grip holds the bar from the start
+        for k in np.flatnonzero(end1):
+            bodies[k].state.blockedDOFs = "x"
     lig = np.abs(x0[:, 0] - 0.5 * NJ.LENGTH) <= 0.5 * NJ.NOTCH_WIDTH
     inner = np.flatnonzero(~end0 & ~end1)
     volume = expansion.element_volumes()
@@ -353,6 +361,7 @@ def summary(rows, t_grip, n, r_mean, strength, voltage) -> dict:
             "onset": None if onset is None else {k: onset[k] for k in (
                 "time_s", "phase", "T_ligament_K", "T_mean_K", "broken_bonds")},
             "peak_ligament_sxx_Pa": max(r["ligament_sxx_Pa"] for r in rows),
+            "min_ligament_sxx_Pa": min(r["ligament_sxx_Pa"] for r in rows),
             "ligament_sxx_before_onset_Pa": intact[-1]["ligament_sxx_Pa"] if onset is not None and intact else None,
             "peak_grip_stress_Pa": max(r["grip_stress_Pa"] for r in rows),
             "separated_at_s": None if sep is None else sep["time_s"],
@@ -378,12 +387,13 @@ def main(argv=None):
     ap.add_argument("--out", default="out/thermal_cracking")
     ap.add_argument("--no-vtk", action="store_true")
     ap.add_argument("--no-pull", action="store_true", help="leave out the mechanical pull of the same bar")
+    ap.add_argument("--clamped", action="store_true", help="both grips hold the bar from the start")
     ap.add_argument("--cache-dir", default=None)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     if args.quick:
         args.n, args.dt, args.steps = 1500, 0.02, 200
     out = run(n=args.n, voltage=args.voltage, t_heat=args.t_heat, t_cool=args.t_cool, dt=args.dt, steps=args.steps,
-              strength=args.strength, sense=args.sense, out_dir=args.out, vtk=not args.no_vtk,
+              strength=args.strength, sense=args.sense, clamped=args.clamped, out_dir=args.out, vtk=not args.no_vtk,
               cache_dir=args.cache_dir)
     if not args.no_pull:
         _say("the same bar pulled at T0, for its mechanical strength")
