@@ -69,6 +69,32 @@ def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
     assert res.stdout.count("current-driven electrodes") == 2 and "solver='petsc'" in res.stdout
 
 
+MPY_VORONOI_SCRIPT = """
+import numpy as np
+from yade import mpy as mp
+from yade_electro.core.errors import BoundaryConditionError
+from yade_electro.yade import ElectricalEngine, Electrode, Material
+from yade_electro.yade import packing as P
+pk = P.dense_packing(P.Box((0, 0, 0), (1e-3, 1e-3, 3e-3)), n=300, seed=1)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+try:
+    ElectricalEngine(material=Material(resistivity=1e-6), law="voronoi", solver="petsc",
+                     boundaries=[Electrode("a", select=ids[z < 0.2e-3], potential=1.0),
+                                 Electrode("b", select=ids[z > 2.8e-3], potential=0.0)])
+except BoundaryConditionError as exc:
+    print("REFUSED", exc, flush=True)
+"""
+
+
+def test_voronoi_law_is_refused_with_yade_mpy_when_built(yade_exe, tmp_path):
+    script = tmp_path / "mpy_voronoi.py"
+    script.write_text(MPY_VORONOI_SCRIPT)
+    res = _mpiexec(yade_exe + ["-n", "-x", str(script)], 2, timeout=300)
+    assert res.returncode == 0 and res.stdout.count("REFUSED") == 2, res.stdout[-2000:] + res.stderr[-3000:]
+    assert res.stdout.count("imports yade.mpy") == 2 and "law='continuum' under mp.mpirun" in res.stdout
+
+
 FAIL_SCRIPT = """
 import numpy as np
 from yade_electro.yade import ElectricalEngine, Electrode, Material, Reader

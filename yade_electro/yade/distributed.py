@@ -24,6 +24,7 @@ the engine is built (:func:`distributed_model`).
 from __future__ import annotations
 
 import os
+import sys
 from typing import Optional, Sequence
 
 import numpy as np
@@ -88,6 +89,11 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
     comm = mpi_comm()
     if law not in DISTRIBUTED_LAWS:
         _refuse(f"the {law!r} law (it does {', '.join(DISTRIBUTED_LAWS)})")
+    if law in REGION_LAWS and "yade.mpy" in sys.modules:
+        raise BoundaryConditionError(
+            f"the {law!r} law runs distributed under plain mpiexec only (its tessellation needs a halo wider than "
+            "yade.mpy's mirrors), and this script imports yade.mpy: run it without yade.mpy (plain mpiexec, "
+            "solver='petsc'), or take law='continuum' under mp.mpirun")
     if walls:
         _refuse("walls (Wall, Electrode(wall=...))")
     held = []
