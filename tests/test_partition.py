@@ -94,6 +94,10 @@ def test_partitioned_solves_match_the_serial_ones(ranks):
         assert abs(r["I_sum"]) < 1e-10 and r["max_dP_rel"] < 1e-9, (pc, r)
         assert r["floating_ok"] and r["floating_warned"] == out["serial_floating_warned"], (pc, r)
     assert out["changed"]["max_dphi_V"] < 1e-9, out["changed"]
+    auto = out["auto"]                 # deflation twice, GAMG twice, then the faster of the two
+    assert auto["max_dphi_V"] < 1e-9 and auto["chosen"] in ("deflation", "gamg"), auto
+    assert auto["preconditioners"][:4] == ["deflation", "deflation", "gamg", "gamg"], auto
+    assert auto["preconditioners"][4:] == [auto["chosen"]] * 2, auto
     for theta in ("0", "0.5", "1"):
         h = out[f"heat_theta_{theta}"]
         assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)

@@ -32,6 +32,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..core.errors import BoundaryConditionError, ThermalError
+from ..solvers.measured import MeasuredChoice
 from ..solvers.partitioned import GhostExchange, PartitionedSystem, mpi_comm, number_unknowns, summed
 from .floating import floating_message
 from .partition import LocalNetwork, OwnedRows
@@ -77,11 +78,15 @@ class _Share:
         self.unknown, self.n_global = number_unknowns(self.exchange, fixed)
         self.rows = OwnedRows(network, self.unknown)
         coords = None if pos is None else np.asarray(pos, dtype=float).reshape(-1, 3)[self.rows.free_owned]
-        if preconditioner == "deflation" and coords is None:
-            raise ValueError("preconditioner='deflation' needs pos= (the owned nodes' positions, m) and spacing=")
-        self.system = PartitionedSystem(self.rows, self.n_global, self.comm, preconditioner=preconditioner,
-                                        rtol=rtol, coords=coords, spacing=spacing, options=options,
-                                        smoother=smoother)
+        if preconditioner in ("deflation", "auto") and coords is None:
+            raise ValueError(f"preconditioner={preconditioner!r} needs pos= (the owned nodes' positions, m) and "
+                             "spacing=")
+
+        def make(name):
+            return PartitionedSystem(self.rows, self.n_global, self.comm, preconditioner=name, rtol=rtol,
+                                     coords=coords, spacing=spacing, options=options, smoother=smoother)
+        # 'auto': the run's first solves measure the candidates, the fastest is kept
+        self.system = MeasuredChoice(make, self.comm) if preconditioner == "auto" else make(preconditioner)
 
     def edge_values(self, values, error, message: str) -> np.ndarray:
         """``values`` as one finite float >= 0 per edge of the share, else ``error(message)``."""
@@ -102,7 +107,9 @@ class PartitionedConduction:
         The electrode each owned node belongs to (index into ``names``), -1 for none.
     names : sequence of electrode names; ``values`` their potentials [V] (a mapping or a sequence)
     comm : mpi4py or petsc4py communicator (default: all ranks)
-    preconditioner : 'deflation' (default, needs ``pos`` and ``spacing``), 'hypre', 'gamg', 'jacobi'
+    preconditioner : 'deflation' (default, needs ``pos`` and ``spacing``), 'hypre', 'gamg', 'jacobi',
+        or 'auto' (the first solves measure deflation and GAMG, the faster is kept:
+        :class:`~yade_electro.solvers.measured.MeasuredChoice`)
     pos : (n_owned, 3) positions [m]; spacing : mean neighbour spacing [m]
     smoother : the deflation's smoother, 'icc' or 'jacobi' (see PartitionedSystem)
     """

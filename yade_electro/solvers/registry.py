@@ -33,6 +33,9 @@ Solvers
     :mod:`yade_electro.solvers.petsc`. An engine under ``mpiexec`` with more than one rank
     runs distributed (:mod:`yade_electro.solvers.partitioned`): ``'petsc'`` then
     preconditions with our deflation.
+``'petsc-auto'``
+    Distributed: the run's first solves measure our deflation and GAMG and the faster is kept
+    (:mod:`yade_electro.solvers.measured`). In one process it is ``'auto'``.
 ``'direct'``
     Sparse LU (SuperLU). ``update``: refactorisation (there is no cheaper exact update).
 ``'auto'``
@@ -88,7 +91,7 @@ _SOLVERS = {"direct": DirectSolver, "cg": CGSolver, "cg-jacobi": CGSolver, "cg-d
 
 
 #: solvers in modules of their own, imported when asked for (their dependencies are optional)
-_LAZY_SOLVERS = ("petsc", "petsc-hypre", "petsc-gamg")
+_LAZY_SOLVERS = ("petsc", "petsc-hypre", "petsc-gamg", "petsc-auto")
 
 
 def solver_names() -> tuple:
@@ -105,6 +108,8 @@ def make_solver(solver="auto", n_unknowns: Optional[int] = None, **kw):
         if n_unknowns is None:
             raise ValueError("solver='auto' needs the number of unknowns")
         solver = auto_solver_name(n_unknowns)
+    if solver == "petsc-auto":            # distributed runs measure; one process takes 'auto'
+        return make_solver("auto", n_unknowns, **kw)
     if solver in _LAZY_SOLVERS:
         from .petsc import PETScSolver
         return PETScSolver(**{"preconditioner": "hypre" if solver == "petsc-hypre" else "gamg", **kw})

@@ -41,8 +41,9 @@ from .scene import ensure_thermal_state, write_body_attribute
 __all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls",
            "PETSC_SOLVERS", "Slabs", "slab_region", "chosen_ids"]
 
-#: the solver names of a distributed run, and the preconditioner each takes
-PETSC_SOLVERS = {"petsc": "deflation", "petsc-hypre": "hypre", "petsc-gamg": "gamg"}
+#: the solver names of a distributed run, and the preconditioner each takes ('petsc-auto': the
+#: first solves measure our deflation and GAMG, and the faster is kept)
+PETSC_SOLVERS = {"petsc": "deflation", "petsc-hypre": "hypre", "petsc-gamg": "gamg", "petsc-auto": "auto"}
 
 
 def world_size() -> int:
