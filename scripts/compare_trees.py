@@ -90,7 +90,8 @@ def compare(a, b):
         worst = max(worst, rel)
         if rel > 1e-10:
             over.append([k, va, vb, rel])
-    return {"numbers": n, "max_rel_diff": worst, "over_1e-10": over[:10]}
+    over.sort(key=lambda o: -o[3])                  # the largest differences first
+    return {"numbers": n, "max_rel_diff": worst, "over_1e-10": over[:10], "n_over_1e-10": len(over)}
 
 
 def main(argv=None):
