@@ -134,5 +134,19 @@ for theta in (0.0, 0.5, 1.0):
     out[f"heat_theta_{theta:g}"] = {"max_dT_K": dT, "dt_s": dt,
                                    "content_rel_diff": abs(par.heat_content(300.0) - float(C @ (ser.temperature - 300.0)))
                                    / abs(float(C @ (ser.temperature - 300.0)))}
+# the heat step with 'auto': backward Euler, 6 steps (deflation, deflation, GAMG, GAMG, choice)
+ser = HeatSolver(C, edges, G, T0, theta=1.0, solver="direct",
+                 conditions=[FixedTemperature("cold", nodes=bottom, temperature=290.0),
+                             Convection("side", nodes=side, h=1.0, t_inf=280.0, area=3e-3)])
+fixed = np.full(n, np.nan)
+fixed[bottom] = 290.0
+par = PartitionedHeat(share, C[own], G[held], T0[own], fixed=fixed[own], h_area=hA[own],
+                      t_inf=np.full(own.shape[0], 280.0), theta=1.0, comm=comm, rtol=1e-13,
+                      pos=g.pos[own], spacing=2e-4, preconditioner="auto")
+for _ in range(6):
+    ser.advance(0.05, sources=Pw)
+    par.advance(0.05, power=Pw[own])
+out["heat_auto"] = {"max_dT_K": max(comm.allgather(float(np.max(np.abs(par.T - ser.temperature[own]), initial=0.0)))),
+                    "chosen": par.info.get("chosen")}
 if rank == 0:
     print(json.dumps(out), flush=True)

@@ -98,6 +98,7 @@ def test_partitioned_solves_match_the_serial_ones(ranks):
     assert auto["max_dphi_V"] < 1e-9 and auto["chosen"] in ("deflation", "gamg"), auto
     assert auto["preconditioners"][:4] == ["deflation", "deflation", "gamg", "gamg"], auto
     assert auto["preconditioners"][4:] == [auto["chosen"]] * 2, auto
+    assert out["heat_auto"]["max_dT_K"] < 1e-9 and out["heat_auto"]["chosen"] in ("deflation", "gamg"), out["heat_auto"]
     for theta in ("0", "0.5", "1"):
         h = out[f"heat_theta_{theta}"]
         assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)
