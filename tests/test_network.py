@@ -372,7 +372,7 @@ def test_solver_objects_keep_their_setup_per_matrix():
 
 def test_make_solver_and_names():
     assert set(solver_names()) == {"auto", "cg", "cg-amg", "cg-deflated", "cg-jacobi", "direct", "petsc", "petsc-hypre",
-                                   "petsc-gamg"}
+                                   "petsc-gamg", "petsc-auto"}
     assert isinstance(make_solver("direct"), DirectSolver)
     assert make_solver("cg").preconditioner == "jacobi"
     assert make_solver("cg", rtol=1e-6).rtol == 1e-6
