@@ -142,6 +142,20 @@ def end_layers(x, r, r_mean, gap=0.1):
     return (x - r) <= gap * r_mean, (LENGTH - x - r) <= gap * r_mean
 
 
+def hold_on_rollers(bodies, x0, end0):
+    """Hold the end layer ``end0`` of the bar on rollers (in x) and remove the rigid-body modes:
+    the element nearest the section's centre held in x, y, z, the one farthest from it across
+    the width in x, z. ``bodies`` and ``x0`` (reference positions [m]) are in the same order.
+    Returns the indices of the two pinned elements."""
+    k_a = int(np.flatnonzero(end0)[np.argmin(np.sum((x0[end0, 1:] - [0.5 * WIDTH, 0.5 * THICKNESS]) ** 2, 1))])
+    k_b = int(np.flatnonzero(end0)[np.argmax(np.abs(x0[end0, 1] - x0[k_a, 1]))])
+    for k in np.flatnonzero(end0):
+        bodies[k].state.blockedDOFs = "x"
+    bodies[k_a].state.blockedDOFs = "xyz"
+    bodies[k_b].state.blockedDOFs = "xz"
+    return k_a, k_b
+
+
 def bin_edges(nbins):
     return np.linspace(0.0, LENGTH, int(nbins) + 1)
 

@@ -108,12 +108,7 @@ def main(argv=None):
     r_mean = float(pk.radii.mean())
     end0 = x0[:, 0] <= x0[:, 0].min() + 1.2 * r_mean
     end1 = x0[:, 0] >= x0[:, 0].max() - 1.2 * r_mean
-    k_a = int(np.flatnonzero(end0)[np.argmin(np.sum((x0[end0, 1:] - [0.5 * NJ.WIDTH, 0.5 * NJ.THICKNESS]) ** 2, 1))])
-    k_b = int(np.flatnonzero(end0)[np.argmax(np.abs(x0[end0, 1] - x0[k_a, 1]))])
-    for k in np.flatnonzero(end0):
-        bodies[k].state.blockedDOFs = "x"
-    bodies[k_a].state.blockedDOFs = "xyz"
-    bodies[k_b].state.blockedDOFs = "xz"
+    k_a, k_b = NJ.hold_on_rollers(bodies, x0, end0)
     e = ThermalExpansion(alpha=ALPHA, mode="bonds", reference_temperature=NJ.T0, iterPeriod=500)
     O.engines = O.engines + [e.runner]
     for b, t in zip(bodies, T.tolist()):

@@ -116,13 +116,7 @@ def build(n, seed, strength, cache_dir=None):
     r_mean = float(pk.radii.mean())
     x0 = pk.centers.copy()
     end0, end1 = NJ.end_layers(x0[:, 0], pk.radii, r_mean, 0.1)
-    mid = np.array([0.5 * NJ.WIDTH, 0.5 * NJ.THICKNESS])
-    k_a = int(np.flatnonzero(end0)[np.argmin(np.sum((x0[end0, 1:] - mid) ** 2, 1))])
-    k_b = int(np.flatnonzero(end0)[np.argmax(np.abs(x0[end0, 1] - x0[k_a, 1]))])
-    for k in np.flatnonzero(end0):
-        bodies[k].state.blockedDOFs = "x"
-    bodies[k_a].state.blockedDOFs = "xyz"
-    bodies[k_b].state.blockedDOFs = "xz"
+    NJ.hold_on_rollers(bodies, x0, end0)
     return ids, bodies, x0, end0, end1, r_mean
 
 
@@ -142,23 +136,36 @@ def cohesive_pairs(ids) -> np.ndarray:
     return np.asarray(out, np.int64).reshape(-1, 2)
 
 
-class _Crack:
-    """The initial bonds, which of them are broken (in the scene, now), and the VTK
-    snapshots of the crack pattern."""
+class InitialBonds:
+    """The scene's cohesive bonds between ``ids`` now, and later which of them are broken.
+
+    Attributes
+    ----------
+    pairs : (m, 2) the bonds as indices into ``ids``
+    """
+
+    def __init__(self, ids):
+        pair = cohesive_pairs(ids)
+        self.ids, self.keys = ids, bond_keys(pair[:, 0], pair[:, 1])
+        self.pairs = np.searchsorted(ids, pair)
+
+    def broken(self) -> np.ndarray:
+        """Which of the bonds are broken in the scene now (m,)."""
+        now = cohesive_pairs(self.ids)
+        return ~np.isin(self.keys, bond_keys(now[:, 0], now[:, 1]))
+
+
+class _Crack(InitialBonds):
+    """The initial bonds, which of them are broken (in the scene, now), the ligament's, and the
+    VTK snapshots of the crack pattern."""
 
     def __init__(self, ids, x0, out_dir):
-        pair = cohesive_pairs(ids)
-        self.keys = bond_keys(pair[:, 0], pair[:, 1])
-        self.pairs = np.searchsorted(ids, pair)
-        self.ids, self.x0 = ids, x0
+        super().__init__(ids)
+        self.x0 = x0
         mid = 0.5 * (x0[self.pairs[:, 0], 0] + x0[self.pairs[:, 1], 0])
         self.in_ligament = np.abs(mid - 0.5 * NJ.LENGTH) <= 0.5 * NJ.NOTCH_WIDTH
         self.dir = os.path.join(out_dir, "vtk") if out_dir else None
         self.written = {}
-
-    def broken(self) -> np.ndarray:
-        now = cohesive_pairs(self.ids)
-        return ~np.isin(self.keys, bond_keys(now[:, 0], now[:, 1]))
 
     def write(self, stage, engine, stress, broken, pos, time_s):
         if self.dir is None or stage in self.written:
@@ -238,16 +245,16 @@ def run(n=5000, seed=1, voltage=0.25, t_heat=0.5, t_cool=1.5, dt=0.01, steps=300
     inner = np.flatnonzero(~end0 & ~end1)
     volume = expansion.element_volumes()
 
-    def measure():
-        """The scene after a relaxation: positions, stress, broken bonds, the free elements'
-        mean |force| over the bonds' mean |normal force| (YADE's unbalancedForce counts the
-        grips' reactions), the grip's force [N]."""
-        read = expansion.read_interactions()
+    def measure(read=None):
+        """The scene after a relaxation (``read``: its interactions, if read already):
+        positions, stress, broken bonds, the free elements' mean |force| over the bonds' mean
+        |normal force| (YADE's unbalancedForce counts the grips' reactions), the grip's force [N]."""
+        read = expansion.read_interactions() if read is None else read
         grip = float(sum(O.forces.f(int(i))[0] for i in ids[end1]))
-        return read[0], expansion.element_stress(read), crack.broken(), unbalanced(), grip
+        return read[0], expansion.element_stress(read), crack.broken(), unbalanced(read), grip
 
-    def unbalanced():
-        fn, _ = expansion.bond_forces()
+    def unbalanced(read=None):
+        fn, _ = expansion.bond_forces(read)
         f_free = np.mean([np.linalg.norm(O.forces.f(int(i))) for i in ids[inner]])
         return float(f_free / max(np.abs(fn).mean(), 1e-300))
 
@@ -265,19 +272,19 @@ def run(n=5000, seed=1, voltage=0.25, t_heat=0.5, t_cool=1.5, dt=0.01, steps=300
             engine.set_electrode("end1", sense)
             phase, t_grip = "cooling", engine.coupled.time
         O.run(steps, True)                          # the engines' call, then the relaxation
-        extra = 0
-        while unbalanced() > tol and extra < max_extra:   # until quasi-static: the engines wait meanwhile
+        read, extra = expansion.read_interactions(), 0
+        while unbalanced(read) > tol and extra < max_extra:   # until quasi-static: the engines wait meanwhile
             for r in (engine.runner, expansion.runner):
                 r.dead = True
             O.run(steps, True)
             for r in (engine.runner, expansion.runner):
                 r.dead = False
-            extra += 1
+            read, extra = expansion.read_interactions(), extra + 1
         h = engine.history.rows[-1]
         if order is None:
             order = np.searchsorted(engine.body_ids, ids)
         T = engine.temperature[order]
-        pos, stress, broken, ub, grip = measure()
+        pos, stress, broken, ub, grip = measure(read)
         R = float(h["R_eq"])
         work += float(h["voltage"]) * float(h["current"]) * float(h["dt"])
         row = {"call": call, "time_s": float(h["time"]), "phase": phase, "voltage_V": float(h["voltage"]),

@@ -235,9 +235,8 @@ def quench(n, dT, E, strength_f, seed=1, strength=STRENGTH, t_end=0.03, dt=5e-4,
     for r in (heat.runner, expansion.runner):
         r.initRun = True
     O.engines = O.engines + [heat.runner, expansion.runner]
-    pairs0 = TC.cohesive_pairs(ids)
-    keys0 = TC.bond_keys(pairs0[:, 0], pairs0[:, 1])
-    pairs = np.searchsorted(ids, pairs0)
+    bonds = TC.InitialBonds(ids)
+    pairs = bonds.pairs
     central = np.abs(x0[:, 0] - 0.5 * SIZE[0]) < 0.5 * SIZE[0] - CENTRAL
     edges = np.linspace(0.0, SIZE[1], nbins + 1)
     slab = np.clip(np.searchsorted(edges, x0[:, 1], side="right") - 1, 0, nbins - 1)
@@ -245,31 +244,31 @@ def quench(n, dT, E, strength_f, seed=1, strength=STRENGTH, t_end=0.03, dt=5e-4,
     volume = expansion.element_volumes()
     order = np.searchsorted(heat.body_ids, ids)
     rows, before, k_before = [], None, -1
-    free = np.ones(ids.size, bool)
 
-    def unbalanced():
+    def unbalanced(read):
         """The elements' mean |force| over the bonds' mean |normal force| (all are free here)."""
-        fn, _ = expansion.bond_forces()
-        f = np.mean([np.linalg.norm(O.forces.f(int(i))) for i in ids[free]])
+        fn, _ = expansion.bond_forces(read)
+        f = np.mean([np.linalg.norm(O.forces.f(int(i))) for i in ids])
         return float(f / max(np.abs(fn).mean(), 1e-300))
 
     call, dt_k = 0, dt0
     while heat.coupled.time < t_end - 1e-12:
         heat.thermal_dt = min(dt_k, t_end - heat.coupled.time)
         O.run(steps, True)                   # the engines' call, then YADE relaxes
-        extra, ub = 0, unbalanced()
+        read = expansion.read_interactions()
+        extra, ub = 0, unbalanced(read)
         while ub > tol and extra < max_extra:   # until quasi-static: the engines wait meanwhile
             for r in (heat.runner, expansion.runner):
                 r.dead = True
             O.run(steps, True)
             for r in (heat.runner, expansion.runner):
                 r.dead = False
-            extra, ub = extra + 1, unbalanced()
+            read = expansion.read_interactions()
+            extra, ub = extra + 1, unbalanced(read)
         call, dt_k = call + 1, dt_k * growth
         T = heat.temperature[order]
-        s = expansion.element_stress()[:, 0, 0]
-        now = TC.cohesive_pairs(ids)
-        broken = ~np.isin(keys0, TC.bond_keys(now[:, 0], now[:, 1]))
+        s = expansion.element_stress(read)[:, 0, 0]      # the scene the last check read
+        broken = bonds.broken()
         w = volume * central
         T_bin = np.bincount(slab, w * T, nbins) / np.bincount(slab, w, nbins)
         s_bin = np.bincount(slab, w * s, nbins) / np.bincount(slab, w, nbins)

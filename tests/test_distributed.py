@@ -60,13 +60,20 @@ except BoundaryConditionError as exc:
 """
 
 
-def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
-    script = tmp_path / "bad.py"
-    script.write_text(BAD_SCRIPT)
+def _refused_on_both_ranks(yade_exe, tmp_path, text) -> str:
+    """Run a script that prints REFUSED and the error under mpiexec -n 2; its stdout, once both
+    ranks refused."""
+    script = tmp_path / "refused.py"
+    script.write_text(text)
     res = _mpiexec(yade_exe + ["-n", "-x", str(script)], 2, timeout=300)
     # the two ranks share stdout, and mpiexec may join their lines ("REFUSEDREFUSED ..."): count the marks
     assert res.returncode == 0 and res.stdout.count("REFUSED") == 2, res.stdout[-2000:] + res.stderr[-3000:]
-    assert res.stdout.count("current-driven electrodes") == 2 and "solver='petsc'" in res.stdout
+    return res.stdout
+
+
+def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
+    out = _refused_on_both_ranks(yade_exe, tmp_path, BAD_SCRIPT)
+    assert out.count("current-driven electrodes") == 2 and "solver='petsc'" in out
 
 
 MPY_VORONOI_SCRIPT = """
@@ -88,11 +95,8 @@ except BoundaryConditionError as exc:
 
 
 def test_voronoi_law_is_refused_with_yade_mpy_when_built(yade_exe, tmp_path):
-    script = tmp_path / "mpy_voronoi.py"
-    script.write_text(MPY_VORONOI_SCRIPT)
-    res = _mpiexec(yade_exe + ["-n", "-x", str(script)], 2, timeout=300)
-    assert res.returncode == 0 and res.stdout.count("REFUSED") == 2, res.stdout[-2000:] + res.stderr[-3000:]
-    assert res.stdout.count("imports yade.mpy") == 2 and "law='continuum' under mp.mpirun" in res.stdout
+    out = _refused_on_both_ranks(yade_exe, tmp_path, MPY_VORONOI_SCRIPT)
+    assert out.count("imports yade.mpy") == 2 and "law='continuum' under mp.mpirun" in out
 
 
 FAIL_SCRIPT = """
