@@ -90,9 +90,11 @@ def _worst(comm, x) -> float:
     return max(comm.allgather(float(x)))
 
 
-def _pair(make, calls, steps_per_call, electrical=True):
+def _pair(make, calls, steps_per_call, electrical=True, walls=(), fed=None):
     """Run the serial engine (solver='direct') and the distributed one (solver='petsc') side by
-    side on the scene, ``calls`` calls; returns both and the worst relative differences."""
+    side on the scene, ``calls`` calls; returns both and the worst relative differences (with
+    ``walls``: also of their contact counts, heat flows and heats; ``fed``: the electrode fed a
+    current, the first: the voltage it takes is compared and is the scale of the potentials)."""
     yade = import_yade()
     O = yade.Omega()
     ser, dis = make("direct", "ser"), make("petsc", "dis")
@@ -104,10 +106,17 @@ def _pair(make, calls, steps_per_call, electrical=True):
     model = dis._distributed.model
     own = model.share.owned_ids
     d_R, d_I, d_phi = 0.0, 0.0, 0.0
+    d_W, d_V, contacts = 0.0, 0.0, []
     for rs, rd in zip(ser.history.rows, dis.history.rows):
+        if fed:
+            d_V = max(d_V, abs(rd["voltage"] - rs["voltage"]) / abs(rs["voltage"]))
         if electrical:
             d_R = max(d_R, abs(rd["R_eq"] - rs["R_eq"]) / abs(rs["R_eq"]))
             d_I = max(d_I, abs(rd["joule_power"] - rs["joule_power"]) / abs(rs["joule_power"]))
+        for w in walls:
+            contacts.append([rs[f"wall_contacts:{w}"], rd[f"wall_contacts:{w}"]])
+            for key in (f"wall_power:{w}", f"wall_heat:{w}"):
+                d_W = max(d_W, abs(rd[key] - rs[key]) / max(abs(rs[key]), 1e-300))
     Ts = ser.temperature_by_id
     Td = model.temperatures_by_id()
     rise = max(abs(v - T0) for v in Ts.values())
@@ -115,35 +124,62 @@ def _pair(make, calls, steps_per_call, electrical=True):
     if electrical:
         phi_s = ser.potential_by_id
         d_phi = _worst(comm, max((abs(p - phi_s[i]) for i, p in zip(own.tolist(), model.potential.tolist())),
-                                 default=0.0))
+                                 default=0.0)) / (abs(dis.history.rows[-1]["voltage"]) if fed else 1.0)
     O.engines = [e for e in O.engines if getattr(e, "label", "") not in ("ser", "dis")]
     out = {"calls": len(dis.history.rows), "R_eq": dis.history.rows[-1].get("R_eq"), "R_rel_diff": d_R,
            "joule_rel_diff": d_I, "potential_diff_over_V": d_phi, "T_rise_K": rise, "T_rel_diff": d_T,
            "owned": int(own.size), "elements": int(dis.history.rows[-1]["elements"]), "wall_s": wall,
            "solve_iterations": dis.history.rows[-1].get("solve_iterations"),
            "substeps_serial_distributed": [ser.history.rows[-1].get("n_substeps"), dis.history.rows[-1].get("n_substeps")]}
-    out["max_rel_diff"] = max(d_R, d_I, d_phi, d_T)
+    if fed:
+        out.update({"fed_potential_rel_diff": d_V, f"V_{fed}": dis.history.rows[-1][f"V_{fed}"],
+                    f"I_{fed}": dis.history.rows[-1][f"I_{fed}"]})
+    if walls:
+        last = dis.history.rows[-1]
+        out.update({"wall_rel_diff": d_W, "wall_contacts_serial_distributed": contacts[-1],
+                    "wall_contacts_equal": all(a == b for a, b in contacts),
+                    "wall_power_W": {w: last[f"wall_power:{w}"] for w in walls},
+                    "wall_heat_J": {w: last[f"wall_heat:{w}"] for w in walls},
+                    "electrode_currents_A": {k[2:]: v for k, v in last.items() if k.startswith("I_")}})
+    out["max_rel_diff"] = max(d_R, d_I, d_phi, d_T, d_W, d_V)
     return out
 
 
 # -- the rod --------------------------------------------------------------------------------
-def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi"):
+#: the current fed into the rod's top face in the surface variant [A]
+ROD_I = 200.0
+
+
+def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False):
+    """``surface``: the electrodes and conditions on the container's faces instead of element
+    layers: the top face fed ROD_I, the bottom face grounded and held at 293 K, the side
+    cooled by convection (each element joined through its half cell, the faces chosen on each
+    rank's region)."""
     from rod_resistance import RHO_304L, build_rod
-    from yade_electro.yade import ElectroThermalEngine, Electrode, FixedTemperature, Integrator, Law, Material, Output
+    from yade_electro.geometry.shapes import as_shape
+    from yade_electro.yade import (Convection, ElectroThermalEngine, Electrode, FixedTemperature, Integrator, Law,
+                                   Material, Output)
     spec = build_rod(n=n, seed=1, cache_dir=cache_dir)
     ids = spec["ids"]
     mat = Material(resistivity=RHO_304L, density=7900.0, specific_heat=500.0, conductivity=16.0, beta=1e-3,
                    reference_temperature=T0)
+    rod = as_shape(spec["container"])
+    if surface:
+        boundaries = [Electrode("top", surface=rod.face("top"), current=ROD_I),
+                      Electrode("bottom", surface=rod.face("bottom"), potential=0.0),
+                      FixedTemperature("cold", surface=rod.face("bottom"), temperature=T0),
+                      Convection("air", surface=rod.face("side"), h=2000.0, t_inf=T0)]
+    else:
+        boundaries = [Electrode("top", select=ids[spec["top"]], potential=1.0),
+                      Electrode("bottom", select=ids[spec["bottom"]], potential=0.0),
+                      FixedTemperature("cold", nodes=ids[spec["bottom"]], temperature=T0)]
 
     def make(solver, label):
         return ElectroThermalEngine(
-            material=mat, law=Law("voronoi", container=spec["container"]) if law == "voronoi" else law,
-            boundaries=[Electrode("top", select=ids[spec["top"]], potential=1.0),
-                        Electrode("bottom", select=ids[spec["bottom"]], potential=0.0),
-                        FixedTemperature("cold", nodes=ids[spec["bottom"]], temperature=T0)],
-            temperature=T0, integrator=Integrator(theta="backward-euler", dt=1e-3), solver=solver, iterPeriod=1,
-            label=label, output=Output(write_back=None))
-    return _pair(make, calls, 1)
+            material=mat, law=Law(law, container=rod) if law == "voronoi" or surface else law,
+            boundaries=boundaries, temperature=T0, integrator=Integrator(theta="backward-euler", dt=1e-3),
+            solver=solver, iterPeriod=1, label=label, output=Output(write_back=None))
+    return _pair(make, calls, 1, fed="top" if surface else None)
 
 
 # -- the pin ---------------------------------------------------------------------------------
@@ -248,6 +284,43 @@ def bed_engine(ids, x, r, solver, label, period, beta=2e-3):
         label=label, output=Output(write_back=None))
 
 
+def floor_id() -> int:
+    """The body id of the bed's floor (build_bed's box)."""
+    yade = import_yade()
+    return next(b.id for b in yade.Omega().bodies if isinstance(b.shape, yade.Box))
+
+
+#: the current fed into the left end [A], out through the floor electrode (walls_engine): a
+#: rise of tens of K
+WALLS_I = 3.0
+
+
+def walls_engine(ids, x, r, solver, label, period, beta=2e-3):
+    """The bed with its floor as a wall electrode (0 V) and as an isothermal wall (280 K), the
+    left end layer fed WALLS_I (its potential found by the solve): the current and the heat
+    leave through the spheres' floor contacts."""
+    from yade_electro.yade import ElectroThermalEngine, Electrode, Integrator, Material, Output, Reader, Wall
+    mat = Material(resistivity=BED_RHO, density=2600.0, specific_heat=800.0, conductivity=2.0, beta=beta,
+                   reference_temperature=T0)
+    floor = floor_id()
+    return ElectroThermalEngine(
+        material=mat, law="contact", reader=Reader(bonds="contacts"),
+        boundaries=[Electrode("left", select=ids[x < x.min() + r], current=WALLS_I),
+                    Electrode("floor", wall=[floor], potential=0.0),
+                    Wall("floor_heat", bodies=[floor], temperature=280.0, conductivity=20.0)],
+        temperature=T0, integrator=Integrator(theta="crank-nicolson", dt=0.5), solver=solver, iterPeriod=period,
+        label=label, output=Output(write_back=None))
+
+
+def walls_case(n=200, calls=8, period=100):
+    """The settling bed on its floor, the floor an electrode and an isothermal wall, the left end
+    fed a current (walls_engine), serial beside distributed; also the left end's potential, the
+    floor's contacts, heat flow and heat against serial."""
+    ids, x, r = build_bed(n)
+    return _pair(lambda solver, label: walls_engine(ids, x, r, solver, label, period), calls, period,
+                 walls=("floor_heat",), fed="left")
+
+
 def heat_case(n=200, calls=8, period=100):
     """Heat only on the bed (HeatEngine): one end held at 350 K, convection to 280 K at the other,
     forward Euler with sub-steps (the call's step is far above the stable one); serial beside
@@ -272,10 +345,12 @@ def bed_case(n=200, calls=8, period=100):
 
 
 # -- the bed in yade.mpy --------------------------------------------------------------------
-def mpy_case(n=200, calls=8, period=100):
+def mpy_case(n=200, calls=8, period=100, walls=False):
     """The bed under yade.mpy (rho_e constant, so that the last call's potential depends on its
     geometry only); the reference is a serial solve on the geometry the workers had at the last
-    call, gathered on rank 0 for this check only."""
+    call, gathered on rank 0 for this check only. ``walls``: the floor (the master's body) is
+    the second electrode and an isothermal wall (walls_engine); the reference joins the spheres
+    that overlap it to an electrode node."""
     from yade import mpy as mp
     from yade_electro.core.graph import ContactGraph
     from yade_electro.core.materials import electrical_conductance
@@ -289,7 +364,9 @@ def mpy_case(n=200, calls=8, period=100):
     order = np.argsort(x, kind="stable")
     for k, i in enumerate(order):            # x slabs; bodies outside subdomain 0 do not move in a serial run
         O.bodies[int(ids[i])].subdomain = 1 + k * workers // len(order)
-    eng = bed_engine(ids, x, r, "petsc", "mpy", period, beta=0.0)
+    floor = O.bodies[floor_id()]
+    floor_top = float(floor.state.pos[2] + floor.shape.extents[2])
+    eng = (walls_engine if walls else bed_engine)(ids, x, r, "petsc", "mpy", period, beta=0.0)
     O.engines = O.engines + [eng.runner]
     t = time.perf_counter()
     mp.mpirun(calls * period, workers + 1, withMerge=False)
@@ -308,20 +385,35 @@ def mpy_case(n=200, calls=8, period=100):
     pairs = cKDTree(pos).query_pairs(2.0 * rad.max(), output_type="ndarray")
     d = np.linalg.norm(pos[pairs[:, 0]] - pos[pairs[:, 1]], axis=1)
     graph = ContactGraph(pos, rad, pairs[d < rad[pairs[:, 0]] + rad[pairs[:, 1]]], ids=gid)
-    c = electrical_conductance(make_law("contact").factor(graph, graph.edges), BED_RHO, graph.edges)
+    law = make_law("contact")
+    edges, c = graph.edges, electrical_conductance(law.factor(graph, graph.edges), BED_RHO, graph.edges)
     left = np.flatnonzero(np.isin(gid, ids[x < x.min() + r]))
-    right = np.flatnonzero(np.isin(gid, ids[x > x.max() - r]))
-    sol = ConductionProblem(graph.n_nodes, graph.edges, c, [Terminal("left", left, potential=1.0),
-                                                            Terminal("right", right, potential=0.0)],
-                            solver="direct").solve()
+    second = "floor" if walls else "right"
+    if walls:                                # the floor: an electrode node joined to the spheres on it
+        overlap = rad - (pos[:, 2] - floor_top)
+        on = np.flatnonzero(overlap > 0)
+        edges = np.concatenate([edges, np.column_stack([on, np.full(on.size, graph.n_nodes)])])
+        c = np.concatenate([c, law.wall_factor(rad[on], overlap[on]) / BED_RHO])
+        terminals = [Terminal("left", left, current=WALLS_I), Terminal("floor", [graph.n_nodes], potential=0.0)]
+    else:
+        right = np.flatnonzero(np.isin(gid, ids[x > x.max() - r]))
+        terminals = [Terminal("left", left, potential=1.0), Terminal("right", right, potential=0.0)]
+    sol = ConductionProblem(graph.n_nodes + int(walls), edges, c, terminals, solver="direct").solve()
     row = eng.history.rows[-1]
-    R = sol.equivalent_resistance("left", "right")
+    R = sol.equivalent_resistance("left", second)
     d_R = abs(row["R_eq"] - R) / R
-    d_I = abs(row["I_left"] - sol.electrode_current["left"]) / abs(sol.electrode_current["left"])
-    d_phi = float(np.max(np.abs(phi - sol.potential)))
-    return {"workers": workers, "calls": len(eng.history.rows), "R_eq": row["R_eq"], "R_rel_diff": d_R,
-            "current_rel_diff": d_I, "potential_diff_over_V": d_phi, "elements": int(row["elements"]),
-            "wall_s": wall, "max_rel_diff": max(d_R, d_I, d_phi)}
+    d_I = max(abs(row[f"I_{k}"] - sol.electrode_current[k]) / abs(sol.electrode_current[k]) for k in ("left", second))
+    volts = abs(sol.electrode_potential["left"] - sol.electrode_potential[second])
+    d_phi = float(np.max(np.abs(phi - sol.potential[:graph.n_nodes]))) / volts
+    out = {"workers": workers, "calls": len(eng.history.rows), "R_eq": row["R_eq"], "R_rel_diff": d_R,
+           "current_rel_diff": d_I, "potential_diff_over_V": d_phi, "elements": int(row["elements"]),
+           "wall_s": wall, "max_rel_diff": max(d_R, d_I, d_phi)}
+    if walls:
+        out.update({"floor_contacts": int(on.size), "floor_contacts_engine": row["wall_contacts:floor_heat"],
+                    "floor_heat_J": row["wall_heat:floor_heat"]})
+        if on.size != row["wall_contacts:floor_heat"]:
+            out["max_rel_diff"] = float("inf")    # the workers did not see the master's floor
+    return out
 
 
 # -- memory -------------------------------------------------------------------------------
@@ -403,8 +495,10 @@ def mem_case(n: int) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="rod,rod-continuum,pin,pin-voronoi,bed,heat,mpy",
-                    help="comma-separated: rod, rod-continuum, pin, pin-voronoi, bed, heat, mpy, mem")
+    ap.add_argument("--cases", default="rod,rod-continuum,rod-surface-voronoi,rod-surface-continuum,pin,pin-voronoi,"
+                                       "bed,walls,heat,mpy",
+                    help="comma-separated: rod, rod-continuum, rod-surface-voronoi, rod-surface-continuum, pin, "
+                         "pin-voronoi, bed, walls, heat, mpy or mpy-walls (one of them, last), mem")
     ap.add_argument("--quick", action="store_true", help="small sizes (the CI test)")
     ap.add_argument("--n-rod", type=int, default=3000)
     ap.add_argument("--n-bed", type=int, default=400)
@@ -428,6 +522,10 @@ def main(argv=None):
     if "rod-continuum" in cases:
         _say(f"rod, continuum law: {n_rod} elements")
         out["rod_continuum"] = rod_case(n_rod, cache_dir=args.cache_dir, law="continuum")
+    for law in ("voronoi", "continuum"):
+        if f"rod-surface-{law}" in cases:
+            _say(f"rod, {law} law, electrodes and conditions on its faces: {n_rod} elements")
+            out[f"rod_surface_{law}"] = rod_case(n_rod, cache_dir=args.cache_dir, law=law, surface=True)
     if "pin" in cases:
         n_pin = 1000 if args.quick else args.n_pin
         _say(f"pin: {n_pin} elements")
@@ -439,16 +537,21 @@ def main(argv=None):
     if "bed" in cases:
         _say(f"bed: about {n_bed} spheres")
         out["bed"] = bed_case(n_bed)
+    if "walls" in cases:
+        _say(f"bed on a floor electrode and isothermal wall: about {n_bed} spheres")
+        out["walls"] = walls_case(n_bed)
     if "mem" in cases:
         _say(f"memory: about {args.mem} spheres")
         out["mem"] = mem_case(args.mem)
         if comm.Get_rank() == 0:
             out["mem_ratio"] = out["mem"]["mem_ratio"]
-    if "mpy" in cases:                      # last: yade.mpy splits the scene for good
-        _say(f"mpy: about {n_bed} spheres")
-        res = mpy_case(n_bed)
-        if res is not None:
-            out["mpy"] = res
+    for case in ("mpy", "mpy-walls"):        # last: yade.mpy splits the scene for good (one of them)
+        if case in cases:
+            _say(f"{case}: about {n_bed} spheres")
+            res = mpy_case(n_bed, walls=case == "mpy-walls")
+            if res is not None:
+                out[case.replace("-", "_")] = res
+            break
     if comm.Get_rank() == 0:
         diffs = [v["max_rel_diff"] for v in out.values() if isinstance(v, dict) and "max_rel_diff" in v]
         out["max_rel_diff"] = max(diffs) if diffs else None

@@ -15,7 +15,7 @@ from lattice import cubic_lattice  # noqa: E402
 from yade_electro.network.conduction import ConductionProblem  # noqa: E402
 from yade_electro.network.distributed import PartitionedConduction, PartitionedHeat  # noqa: E402
 from yade_electro.network.heat_conditions import Convection, FixedTemperature  # noqa: E402
-from yade_electro.network.kirchhoff import Electrode  # noqa: E402
+from yade_electro.network.kirchhoff import Electrode, edge_power  # noqa: E402
 from yade_electro.network.partition import split_network  # noqa: E402
 from yade_electro.network.transient import HeatSolver  # noqa: E402
 from yade_electro.solvers.partitioned import mpi_comm  # noqa: E402
@@ -62,7 +62,6 @@ for pc in ("deflation", "hypre", "gamg"):
     R = pcnd.equivalent_resistance()
     I = pcnd.electrode_currents()
     P = pcnd.joule_power()
-    from yade_electro.network.kirchhoff import edge_power
     p_edge = edge_power(sol.branch_current, c)
     P_ser = 0.5 * (np.bincount(edges[:, 0], p_edge, n) + np.bincount(edges[:, 1], p_edge, n))
     d_P = max(comm.allgather(float(np.max(np.abs(P - P_ser[own]), initial=0.0))))
@@ -109,6 +108,45 @@ with warnings.catch_warnings():
         picked.append(pcnd.info["preconditioner"])
 out["auto"] = {"max_dphi_V": worst, "preconditioners": picked, "chosen": pcnd.info["chosen"]}
 
+# -- links: an electrode apart from the elements (a wall), joined to the top layer; the links'
+# values change on the kept structure, then their nodes change (a new structure) -------------
+worst_link = {"phi": 0.0, "I": 0.0, "P": 0.0}
+linked = [top[::2], top[::2], top[1::3]]                   # the third: other nodes touch the wall
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    pcnd = None
+    for k, nodes in enumerate(linked):
+        gl = 0.5 + 0.1 * k + 0.05 * np.arange(nodes.size)
+        e_all = np.concatenate([edges, np.column_stack([nodes, np.full(nodes.size, n)])])
+        c_all = np.concatenate([c, gl])
+        ref = ConductionProblem(n + 1, e_all, c_all, [Electrode("a", bottom, potential=1.0),
+                                                      Electrode("w", [n], potential=0.0)], solver="direct").solve()
+        links = np.zeros((2, own.size))
+        links[1, np.searchsorted(own, nodes[np.isin(nodes, own)])] = gl[np.isin(nodes, own)]
+        el_a = np.where(np.isin(own, bottom), 0, -1)
+        if pcnd is None or comm.allreduce(int(not pcnd.links_fit(links))):    # new linked nodes: anew
+            if pcnd is not None:
+                pcnd.close()
+            pcnd = PartitionedConduction(share, c[held], el_a, ["a", "w"], {"a": 1.0, "w": 0.0}, comm=comm,
+                                         preconditioner="deflation", rtol=1e-12, pos=g.pos[own], spacing=2e-4,
+                                         links=links)
+        pcnd.update_conductance(c[held], links)
+        phi = pcnd.solve()
+        I = pcnd.electrode_currents()
+        p_ref = edge_power(ref.branch_current, c_all)
+        m = edges.shape[0]
+        P_ref = 0.5 * (np.bincount(edges[:, 0], p_ref[:m], n + 1) + np.bincount(edges[:, 1], p_ref[:m], n + 1))[:n]
+        P_ref += np.bincount(nodes, p_ref[m:], n)            # a link's heat is its element's
+        worst_link["phi"] = max(worst_link["phi"], max(comm.allgather(float(np.max(np.abs(
+            phi[:share.n_owned] - ref.potential[own]), initial=0.0)))))
+        worst_link["I"] = max(worst_link["I"], max(abs(I[t] - ref.electrode_current[t]) / abs(ref.electrode_current[t])
+                                                   for t in ("a", "w")))
+        worst_link["P"] = max(worst_link["P"], max(comm.allgather(float(np.max(np.abs(
+            pcnd.joule_power() - P_ref[own]), initial=0.0)))) / float(np.max(P_ref)))
+        worst_link["R_rel_diff"] = abs(pcnd.equivalent_resistance() - ref.equivalent_resistance("a", "w")) / \
+            ref.equivalent_resistance("a", "w")
+out["links"] = worst_link
+
 # -- heat -----------------------------------------------------------------------------------
 C = rng.uniform(1e-3, 2e-3, n)
 G = c * 1e-2
@@ -134,6 +172,36 @@ for theta in (0.0, 0.5, 1.0):
     out[f"heat_theta_{theta:g}"] = {"max_dT_K": dT, "dt_s": dt,
                                    "content_rel_diff": abs(par.heat_content(300.0) - float(C @ (ser.temperature - 300.0)))
                                    / abs(float(C @ (ser.temperature - 300.0)))}
+# an isothermal wall (a linked fixed temperature) on the side layer, its links changing
+from yade_electro.network.boundary import FixedValue  # noqa: E402
+for theta in (0.0, 0.5, 1.0):
+    wall_nodes = np.flatnonzero(lattice_k == 25)
+    Gw = np.linspace(1e-3, 4e-3, wall_nodes.size)
+    ser = HeatSolver(C, edges, G, T0, theta=theta, solver="direct",
+                     conditions=[FixedTemperature("cold", nodes=bottom, temperature=290.0),
+                                 FixedValue("wall", nodes=np.zeros(0, np.int64), value=350.0)],
+                     nodes_of={"wall": wall_nodes}, link_of={"wall": Gw})
+    fixed = np.full(n, np.nan)
+    fixed[bottom] = 290.0
+    par = PartitionedHeat(share, C[own], G[held], T0[own], fixed=fixed[own], theta=theta, comm=comm, rtol=1e-13,
+                          pos=g.pos[own], spacing=2e-4, links={"wall": 350.0})
+    Gw_all = np.zeros(n)
+    dt = 0.5 * par.stable_time_step() if theta == 0.0 else 0.05
+    for step in range(4):
+        Gw_step = Gw * (1.0 + 0.3 * step)
+        Gw_all[:] = 0.0
+        Gw_all[wall_nodes] = Gw_step
+        ser.set_links("wall", wall_nodes, Gw_step)
+        par.set_links("wall", Gw_all[own])
+        if theta == 0.0:
+            dt = 0.5 * par.stable_time_step()
+        ser.advance(dt, sources=Pw)
+        par.advance(dt, power=Pw[own])
+    dT = max(comm.allgather(float(np.max(np.abs(par.T - ser.temperature[own]), initial=0.0))))
+    out[f"wall_theta_{theta:g}"] = {
+        "max_dT_K": dT, "heat_rel_diff": abs(par.link_energy["wall"] - ser.link_energy["wall"]) /
+        abs(ser.link_energy["wall"]), "flow_rel_diff": abs(par.link_flows()["wall"] - ser.link_flows()["wall"]) /
+        abs(ser.link_flows()["wall"])}
 # the heat step with 'auto': backward Euler, 6 steps (deflation, deflation, GAMG, GAMG, choice)
 ser = HeatSolver(C, edges, G, T0, theta=1.0, solver="direct",
                  conditions=[FixedTemperature("cold", nodes=bottom, temperature=290.0),

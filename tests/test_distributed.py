@@ -28,8 +28,16 @@ def test_distributed_case_matches_serial_with_two_workers(yade_exe):
     assert res.returncode == 0 and len(rows) == 1, res.stdout[-2000:] + res.stderr[-4000:]
     out = rows[0]
     assert out["workers"] == {"plain_mpiexec": 3, "yade_mpy": 2}
-    for case in ("rod", "rod_continuum", "pin", "pin_voronoi", "bed", "heat", "mpy"):
+    for case in ("rod", "rod_continuum", "rod_surface_voronoi", "rod_surface_continuum", "pin", "pin_voronoi", "bed",
+                 "walls", "heat", "mpy"):
         assert out[case]["max_rel_diff"] < 1e-8, (case, out[case])
+    walls = out["walls"]                                   # the floor: an electrode and an isothermal wall
+    assert walls["wall_contacts_equal"] and walls["wall_contacts_serial_distributed"][0] > 10, walls
+    assert walls["wall_heat_J"]["floor_heat"] < 0 and walls["electrode_currents_A"]["floor"] < 0, walls
+    assert abs(walls["I_left"] - 3.0) < 1e-9 and walls["V_left"] > 0, walls   # fed 3 A: its potential found
+    for law in ("voronoi", "continuum"):                   # faces chosen on each rank's region, top fed 200 A
+        rod = out[f"rod_surface_{law}"]
+        assert abs(rod["I_top"] - 200.0) < 1e-6 and rod["fed_potential_rel_diff"] < 1e-8 and rod["T_rise_K"] > 1, rod
     assert out["rod"]["elements"] > 900 and out["rod"]["owned"] < out["rod"]["elements"]
     assert out["bed"]["T_rise_K"] > 1.0 and out["rod"]["T_rise_K"] > 10.0
     assert out["mpy"]["calls"] >= 5 and out["max_rel_diff"] < 1e-8
@@ -37,6 +45,19 @@ def test_distributed_case_matches_serial_with_two_workers(yade_exe):
     assert sub[0] == sub[1] > 1                            # forward Euler split the same way
     for pin in ("pin", "pin_voronoi"):                     # bonds broke, the shares were rebuilt
         assert out[pin]["compared_calls"] >= 5 and out[pin]["R_ratio_last_finite"] > 1.05, out[pin]
+
+
+def test_walls_held_by_the_master_in_yade_mpy(yade_exe):
+    """The floor is the master's body (subdomain 0); each worker joins its own spheres on it to
+    the floor electrode and the isothermal wall: the answer is a serial solve's on the workers'
+    geometry, and the workers count every sphere on the floor."""
+    res = _mpiexec(yade_exe + ["-n", "-x", os.path.join(ROOT, "cases", "distributed.py"), "--quick",
+                               "--cases", "mpy-walls"], 3)
+    rows = [json.loads(line) for line in res.stdout.splitlines() if line.startswith('{"ranks"')]
+    assert res.returncode == 0 and len(rows) == 1, res.stdout[-2000:] + res.stderr[-4000:]
+    out = rows[0]["mpy_walls"]
+    assert out["workers"] == 2 and out["max_rel_diff"] < 1e-8, out
+    assert out["floor_contacts"] == out["floor_contacts_engine"] > 10 and out["floor_heat_J"] < 0, out
 
 
 BAD_SCRIPT = """
@@ -54,7 +75,7 @@ from yade_electro.yade import Reader
 kw = dict(material=Material(resistivity=1e-6), reader=Reader(bonds="contacts"), law="contact", solver="petsc")
 try:
     ElectricalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], current=1.0),
-                                 Electrode("b", select=ids[z > 6.5], potential=0.0)], **kw)
+                                 Electrode("b", select=ids[z > 6.5], current=-1.0)], **kw)
 except BoundaryConditionError as exc:
     print("REFUSED", exc, flush=True)
 """
@@ -73,7 +94,7 @@ def _refused_on_both_ranks(yade_exe, tmp_path, text) -> str:
 
 def test_distributed_refuses_what_it_does_not_do_when_built(yade_exe, tmp_path):
     out = _refused_on_both_ranks(yade_exe, tmp_path, BAD_SCRIPT)
-    assert out.count("current-driven electrodes") == 2 and "solver='petsc'" in out
+    assert out.count("has an imposed current: hold one at a potential") == 2, out
 
 
 MPY_VORONOI_SCRIPT = """
@@ -97,6 +118,32 @@ except BoundaryConditionError as exc:
 def test_voronoi_law_is_refused_with_yade_mpy_when_built(yade_exe, tmp_path):
     out = _refused_on_both_ranks(yade_exe, tmp_path, MPY_VORONOI_SCRIPT)
     assert out.count("imports yade.mpy") == 2 and "law='continuum' under mp.mpirun" in out
+
+
+MPY_SURFACE_SCRIPT = """
+import numpy as np
+from yade import mpy as mp
+from yade_electro.core.errors import BoundaryConditionError
+from yade_electro.yade import ElectricalEngine, Electrode, Law, Material
+from yade_electro.yade import packing as P
+box = P.Box((0, 0, 0), (1e-3, 1e-3, 3e-3))
+pk = P.dense_packing(box, n=300, seed=1)
+ids = np.asarray(P.add_bonded_packing(pk))
+z = pk.centers[:, 2]
+try:
+    ElectricalEngine(material=Material(resistivity=1e-6), law=Law("continuum", container=box), solver="petsc",
+                     boundaries=[Electrode("a", surface=box.face("z-"), potential=1.0),
+                                 Electrode("b", select=ids[z > 2.8e-3], potential=0.0)])
+except BoundaryConditionError as exc:
+    print("REFUSED", exc, flush=True)
+"""
+
+
+def test_surface_electrodes_are_refused_with_yade_mpy_when_built(yade_exe, tmp_path):
+    """A surface's half cells need the bounded cells of a rank's elements: yade.mpy's mirrors
+    are too thin a halo for them."""
+    out = _refused_on_both_ranks(yade_exe, tmp_path, MPY_SURFACE_SCRIPT)
+    assert out.count("run distributed under plain mpiexec only") == 2 and "['a']" in out, out
 
 
 FAIL_SCRIPT = """

@@ -102,6 +102,10 @@ def test_partitioned_solves_match_the_serial_ones(ranks):
     for theta in ("0", "0.5", "1"):
         h = out[f"heat_theta_{theta}"]
         assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)
+        w = out[f"wall_theta_{theta}"]          # an isothermal wall's links, values changing
+        assert w["max_dT_K"] < 1e-9 and w["heat_rel_diff"] < 1e-10 and w["flow_rel_diff"] < 1e-10, (theta, w)
+    lk = out["links"]                           # a wall electrode: links' values, then their nodes change
+    assert lk["phi"] < 1e-10 and lk["I"] < 1e-10 and lk["P"] < 1e-9 and lk["R_rel_diff"] < 1e-10, lk
 
 
 @pytest.mark.parametrize("ranks", [2, 3])

@@ -112,12 +112,23 @@ class PartitionedConduction:
         :class:`~yade_electro.solvers.measured.MeasuredChoice`)
     pos : (n_owned, 3) positions [m]; spacing : mean neighbour spacing [m]
     smoother : the deflation's smoother, 'icc' or 'jacobi' (see PartitionedSystem)
+    currents : per electrode, an imposed current [A] (fed into the network) or None (held at
+        its potential in ``values``); default None for all. An imposed current is met by
+        superposition: a solve with those electrodes at 0 V, one per such electrode at 1 V
+        (the others at 0 V), and their potentials from the small system of the currents (each
+        a re-solve on the kept setup).
+    links : (n_electrodes, n_owned) conductances [S] joining owned nodes to an electrode held
+        apart from them (a wall or surface electrode: a node at the electrode's potential that
+        is not an element); None: none. Which nodes are linked (> 0) is part of the structure
+        (:meth:`links_fit`); the values may change (:meth:`update_conductance`).
     """
 
     def __init__(self, network: LocalNetwork, conductance, electrode_of, names: Sequence[str], values, *,
                  comm=None, preconditioner: str = "deflation", rtol: float = 1e-10, pos=None,
-                 spacing: Optional[float] = None, options: Optional[dict] = None, smoother: str = "icc"):
+                 spacing: Optional[float] = None, options: Optional[dict] = None, smoother: str = "icc",
+                 links=None, currents=None):
         self.names = [str(n) for n in names]
+        self.imposed = self._imposed(currents)
         el = np.asarray(electrode_of, dtype=np.int64)
         if el.shape != (network.n_owned,) or (el.size and (el.min() < -1 or el.max() >= len(self.names))):
             raise BoundaryConditionError(f"electrode_of must give, per owned node, an index into the {len(self.names)} "
@@ -125,15 +136,19 @@ class PartitionedConduction:
         self.values = self._values(values)
         comm = mpi_comm(comm)
         ex = GhostExchange(network, comm)
-        held = summed(comm, np.bincount(el[el >= 0], minlength=len(self.names)), np.int64)
+        self.links = self._links(links, network.n_owned)
+        self.linked = self.links > 0
+        held = summed(comm, np.bincount(el[el >= 0], minlength=len(self.names)) + self.linked.sum(axis=1), np.int64)
         empty = [n for n, k in zip(self.names, held) if k == 0]
         if empty:
-            raise BoundaryConditionError(f"electrode(s) {empty} hold no element on any rank: check their selection")
-        reach = spread_over_parts(network, ex, (el >= 0).astype(np.int64), op="max")
+            raise BoundaryConditionError(f"electrode(s) {empty} hold or touch no element on any rank: check their "
+                                         "selection (a wall electrode: is the bed pressed against it?)")
+        reach = spread_over_parts(network, ex, ((el >= 0) | self.linked.any(axis=0)).astype(np.int64), op="max")
         self.floating = reach == 0
         part = spread_over_parts(network, ex, network.owned_key, op="min")
         # the parts each electrode touches (its elements' labels, from every rank)
-        touched = comm.allgather([np.unique(part[el == k]) for k in range(len(self.names))])
+        touched = comm.allgather([np.unique(np.concatenate([part[el == k], part[self.linked[k]]]))
+                                  for k in range(len(self.names))])
         self._parts_of = [set(np.concatenate([t[k] for t in touched]).tolist()) for k in range(len(self.names))]
         n_float = int(comm.allreduce(int(np.count_nonzero(self.floating))))
         if n_float:
@@ -144,8 +159,37 @@ class PartitionedConduction:
                              exchange=ex, smoother=smoother)
         self.electrode_of = el
         self._el_local = ex.local(np.where(self.floating, len(self.names), el))
-        self._x = None
+        self._x = {}
         self.update_conductance(conductance)
+
+    def _imposed(self, currents) -> np.ndarray:
+        """The imposed currents [A] per electrode, NaN where held at a potential."""
+        if currents is None:
+            return np.full(len(self.names), np.nan)
+        if isinstance(currents, Mapping):
+            currents = [currents.get(n) for n in self.names]
+        out = np.array([np.nan if v is None else float(v) for v in currents])
+        if out.shape != (len(self.names),) or np.any(np.isinf(out)):
+            raise BoundaryConditionError(f"currents: one finite value (A) or None per electrode {self.names}")
+        if np.all(np.isfinite(out)):
+            raise BoundaryConditionError(f"every electrode of {self.names} has an imposed current: hold one at a "
+                                         "potential (potential=0, the ground) to give the current a return path")
+        return out
+
+    def _links(self, links, n: int) -> np.ndarray:
+        if links is None:
+            return np.zeros((len(self.names), n))
+        g = np.asarray(links, dtype=float)
+        if g.shape != (len(self.names), n) or not np.all(np.isfinite(g)) or np.any(g < 0):
+            raise BoundaryConditionError(f"links must be finite conductances >= 0 (S), shaped (electrodes, owned "
+                                         f"nodes) = ({len(self.names)}, {n}), got shape {g.shape}")
+        return g
+
+    def links_fit(self, links) -> bool:
+        """True when ``links`` join the same nodes to the same electrodes as the kept
+        structure (then :meth:`update_conductance` takes them; else build anew). Local: the
+        caller joins the ranks' answers."""
+        return bool(np.array_equal(self._links(links, self.network.n_owned) > 0, self.linked))
 
     def _values(self, values) -> np.ndarray:
         if isinstance(values, Mapping):
@@ -170,39 +214,105 @@ class PartitionedConduction:
         """Free the solver's PETSc objects (collective); the object is not usable after."""
         self._share.system.destroy()
 
-    def update_conductance(self, conductance):
-        """New edge conductances [S], same edges (collective); the setup is kept."""
+    def update_conductance(self, conductance, links=None):
+        """New edge conductances [S], same edges, and new link conductances (same linked
+        nodes: :meth:`links_fit`) when given (collective); the setup is kept."""
         s = self._share
         c = self.conductance = s.edge_values(conductance, BoundaryConditionError,
                                              "conductances must be finite and >= 0 (S), one per edge of the share")
-        s.system.set_values(s.rows.values(c), s.exchange)
+        if links is not None:
+            if not self.links_fit(links):
+                raise BoundaryConditionError("the links join other nodes than the kept structure's: build anew")
+            self.links = self._links(links, self.network.n_owned)
+        s.system.set_values(s.rows.values(c, self.links.sum(axis=0)), s.exchange)
 
-    def solve(self, values=None):
-        """The potential [V] on the local nodes (owned, then ghosts) (collective)."""
+    def solve(self, values=None, currents=None):
+        """The potential [V] on the local nodes (owned, then ghosts) (collective): the
+        electrodes at ``values`` (V), or, for those with an imposed current (``currents``, as
+        the constructor's; default the kept ones), at the potentials that feed it."""
         if values is not None:
             self.values = self._values(values)
+        if currents is not None:
+            self.imposed = self._imposed(currents)
+        fed = np.flatnonzero(np.isfinite(self.imposed))
+        if fed.size == 0:
+            return self._solve_at(self.values, "held")
+        self._check_return_paths(fed)
+        base = self.values.copy()
+        base[fed] = 0.0
+        phi = self._solve_at(base, "held")
+        I0, iterations = self._currents(), int(self.info["iterations"])
+        unit, S = [], np.zeros((fed.size, fed.size))
+        for col, k in enumerate(fed):                # each fed electrode at 1 V, every other at 0 V
+            v = np.zeros(len(self.names))
+            v[k] = 1.0
+            unit.append(self._solve_at(v, int(k)))
+            S[:, col] = self._currents()[fed]
+            iterations += int(self.info["iterations"])
+        U = np.linalg.solve(S, self.imposed[fed] - I0[fed])
+        base[fed] = U
+        self.values = base
+        self.potential = phi + sum(u * p for u, p in zip(U, unit))
+        self.info = dict(self.info, iterations=iterations, solves=1 + fed.size)
+        return self.potential
+
+    def _solve_at(self, values, key):
+        """One solve with the electrodes at ``values`` [V]; ``key`` names the start kept for it."""
         s = self._share
+        self.values = np.asarray(values, dtype=float)
         fixed = np.append(self.values, 0.0)[self._el_local]
-        rhs = s.rows.fixed_rhs(self.conductance, fixed)
-        x, self.info = s.system.solve(rhs, x0=self._x)
-        self._x = x
+        rhs = s.rows.fixed_rhs(self.conductance, fixed) + (self.values @ self.links)[s.rows.free_owned]
+        x, self.info = s.system.solve(rhs, x0=self._x.get(key))
+        self._x[key] = x
         own = fixed[:self.network.n_owned].copy()
         own[s.rows.free_owned] = x
         self.potential = s.exchange.local(own)
         return self.potential
+
+    def _check_return_paths(self, fed):
+        """BoundaryConditionError when an electrode with an imposed current is joined (through
+        the parts it touches and the electrodes they hold) to no electrode held at a potential."""
+        group = list(range(len(self.names)))         # electrodes joined by the parts they share
+
+        def root(k):
+            while group[k] != k:
+                k = group[k]
+            return k
+        for a in range(len(self.names)):
+            for b in range(a + 1, len(self.names)):
+                if self._parts_of[a] & self._parts_of[b]:
+                    group[root(a)] = root(b)
+        grounded = {root(k) for k in range(len(self.names)) if not np.isfinite(self.imposed[k])}
+        lone = [self.names[k] for k in fed if root(int(k)) not in grounded]
+        if lone:
+            raise BoundaryConditionError(
+                f"an imposed current has no return path: electrode(s) {lone} touch no part of the network that "
+                "also holds an electrode at a potential; ground one electrode (potential=0) in that part")
 
     def branch_current(self) -> np.ndarray:
         """Current [A] of each edge of the share, from its first node to its second."""
         e = self.network.edges
         return self.conductance * (self.potential[e[:, 0]] - self.potential[e[:, 1]])
 
+    def link_currents(self) -> np.ndarray:
+        """(n_electrodes, n_owned) current [A] of each link, from its electrode into the node."""
+        return self.links * (self.values[:, None] - self.potential[None, :self.network.n_owned])
+
+    def _currents(self) -> np.ndarray:
+        """Current [A] leaving each electrode into the network, summed over the ranks: through
+        its elements' edges and links, and through its links."""
+        out = out_of_owned(self.network, self.branch_current()) - self.link_currents().sum(axis=0)
+        el = self.electrode_of
+        mine = np.bincount(el[el >= 0], out[el >= 0], len(self.names)) + self.link_currents().sum(axis=1)
+        return summed(self._share.comm, mine)
+
     def electrode_currents(self) -> dict:
         """Current [A] leaving each electrode into the network, summed over the ranks."""
-        out = out_of_owned(self.network, self.branch_current())
-        el = self.electrode_of
-        mine = np.bincount(el[el >= 0], out[el >= 0], len(self.names))
-        total = summed(self._share.comm, mine)
-        return dict(zip(self.names, total.tolist()))
+        return dict(zip(self.names, self._currents().tolist()))
+
+    def electrode_potentials(self) -> dict:
+        """Potential [V] of each electrode (an imposed current's: the one that feeds it)."""
+        return dict(zip(self.names, self.values.tolist()))
 
     def equivalent_resistance(self, a: Optional[str] = None, b: Optional[str] = None) -> float:
         """(V_a - V_b) / I_a between two electrodes [ohm] (the first two by default); inf when
@@ -216,7 +326,8 @@ class PartitionedConduction:
         return float((self.values[ka] - self.values[kb]) / i) if i != 0 else float("inf")
 
     def joule_power(self) -> np.ndarray:
-        """Joule heat [W] of each owned node: each edge's c dV^2 shared half and half by its ends."""
+        """Joule heat [W] of each owned node: each edge's c dV^2 shared half and half by its
+        ends, and its links' c dV^2."""
         e = self.network.edges
         p = self.conductance * (self.potential[e[:, 0]] - self.potential[e[:, 1]]) ** 2
         n = self.network.n_owned
@@ -224,6 +335,8 @@ class PartitionedConduction:
         for col in (0, 1):
             mine = e[:, col] < n
             out += 0.5 * np.bincount(e[mine, col], p[mine], n)
+        if self.linked.any():                   # a link's heat is its element's, as serially
+            out += (self.links * (self.values[:, None] - self.potential[None, :n]) ** 2).sum(axis=0)
         return out
 
 
@@ -241,14 +354,21 @@ class PartitionedHeat:
     theta : as :func:`~yade_electro.network.theta.theta_of` (default backward Euler)
     safety, max_substeps : the explicit sub-steps' fraction of the stable step and their limit
     smoother : the deflation's smoother, 'icc' or 'jacobi' (see PartitionedSystem)
+    links : dict name -> temperature [K] of fixed temperatures held apart from the nodes (an
+        isothermal wall) and joined to them by conductances set by :meth:`set_links`; the heat
+        each gives is in ``link_energy`` [J] and :meth:`link_flows` [W]
     """
 
     def __init__(self, network: LocalNetwork, capacity, conductance, temperature, *, fixed=None, h_area=None,
                  t_inf=None, theta="backward-euler", comm=None, preconditioner: str = "deflation",
                  rtol: float = 1e-12, pos=None, spacing: Optional[float] = None, options: Optional[dict] = None,
-                 safety: float = 0.9, max_substeps: int = 100000, smoother: str = "icc"):
+                 safety: float = 0.9, max_substeps: int = 100000, smoother: str = "icc", links=None):
         n = network.n_owned
         self.safety, self.max_substeps, self.substeps = float(safety), int(max_substeps), 0
+        self.link_names = list(links or {})
+        self.link_value = np.array([float(v) for v in (links or {}).values()])
+        self.link_G = np.zeros((len(self.link_names), n))
+        self.link_energy = {k: 0.0 for k in self.link_names}
         C = np.asarray(capacity, dtype=float)
         if C.shape != (n,) or not np.all(np.isfinite(C)) or np.any(C <= 0):
             raise ThermalError(f"heat capacities must be finite and > 0 (J/K), one per owned node ({n})")
@@ -281,22 +401,47 @@ class PartitionedHeat:
             conductance, ThermalError, "thermal conductances must be finite and >= 0 (W/K), one per edge of the share")
         self._dt = None                         # the step matrix is made again at the next step
 
+    def set_links(self, name: str, conductance):
+        """The conductances [W/K] joining each owned node to the linked fixed temperature
+        ``name`` now (0: not touching); a value change, from the next step on."""
+        if name not in self.link_names:
+            raise ThermalError(f"no linked fixed temperature named {name!r}; have {self.link_names}")
+        g = np.asarray(conductance, dtype=float)
+        if g.shape != (self.network.n_owned,) or not np.all(np.isfinite(g)) or np.any(g < 0):
+            raise ThermalError(f"links of {name!r}: conductances must be finite and >= 0 (W/K), one per owned node")
+        k = self.link_names.index(name)
+        if not np.array_equal(g, self.link_G[k]):
+            self.link_G[k] = g
+            self._dt = None                     # the step matrix is made again at the next step
+
+    def link_flows(self, T_owned=None) -> dict:
+        """Heat flow [W] into the network through each linked fixed temperature, all ranks."""
+        T = self.T if T_owned is None else np.asarray(T_owned, dtype=float)
+        mine = (self.link_G * (self.link_value[:, None] - T[None, :])).sum(axis=1)
+        return dict(zip(self.link_names, summed(self._share.comm, mine).tolist())) if self.link_names else {}
+
+    @property
+    def _hA(self) -> np.ndarray:
+        """h A plus the links' conductances [W/K] per owned node (what leaves to fixed ambients)."""
+        return self.h_area + self.link_G.sum(axis=0)
+
     def _free(self, a):
         return np.asarray(a)[self._share.rows.free_owned]
 
     def flow(self, T_owned=None) -> np.ndarray:
         """``(K T)_i + h_i A_i T_i`` [W] on every owned node: the heat it gives its neighbours
-        (fixed ones too) and the ambient's h A T part (collective: ghosts from their owners)."""
+        (fixed ones too) and the ambient's h A T part, links included (collective: ghosts from
+        their owners)."""
         T0 = self.T if T_owned is None else np.asarray(T_owned, dtype=float)
         T = self._share.exchange.local(T0)
         e = self.network.edges
-        return out_of_owned(self.network, self.conductance * (T[e[:, 0]] - T[e[:, 1]])) + self.h_area * T0
+        return out_of_owned(self.network, self.conductance * (T[e[:, 0]] - T[e[:, 1]])) + self._hA * T0
 
     def stable_time_step(self) -> float:
         """The forward-Euler bound min C_i / (sum_j G_ij + h_i A_i) over the free nodes [s], all ranks."""
         from mpi4py import MPI
         e, n = self.network.edges, self.network.n_owned
-        d = self.h_area.copy()
+        d = self._hA
         for col in (0, 1):
             mine = e[:, col] < n
             d += np.bincount(e[mine, col], self.conductance[mine], n)
@@ -327,30 +472,40 @@ class PartitionedHeat:
                                        f"{largest:.3e} s), more than max_substeps = {self.max_substeps}; take "
                                        "smaller steps or theta >= 1/2")
         T = self.T
+        flows = np.zeros(len(self.link_names))
         for _ in range(self.substeps):
-            T = self._step(T, dt / self.substeps, P)
+            T, T_theta = self._step(T, dt / self.substeps, P)
+            flows += (self.link_G * (self.link_value[:, None] - T_theta[None, :])).sum(axis=1)
         self.T = T
         self.time += dt
+        if self.link_names:                     # at the scheme's theta-point: the exact discrete balance
+            got = summed(self._share.comm, flows * (dt / self.substeps))
+            for k, name in enumerate(self.link_names):
+                self.link_energy[name] += float(got[k])
         return T
 
-    def _step(self, T0, h, P) -> np.ndarray:
+    def _step(self, T0, h, P):
+        """One (sub-)step of ``h`` [s]: (T at its end, T at its theta point)."""
         s, th = self._share, self.theta
-        rhs = self._free(self.h_area * self.t_inf + P - self.flow(T0))
+        ambient = self.h_area * self.t_inf + self.link_value @ self.link_G if self.link_names \
+            else self.h_area * self.t_inf
+        rhs = self._free(ambient + P - self.flow(T0))
         Cdt = self.capacity / h
         if th == 0.0:
             dT = rhs / self._free(Cdt)
         else:
             if self._dt != h:                   # the step matrix for this step and these conductances
-                s.system.set_values(s.rows.values(th * self.conductance, th * self.h_area + Cdt), s.exchange)
+                s.system.set_values(s.rows.values(th * self.conductance, th * self._hA + Cdt), s.exchange)
             dT, self.info = s.system.solve(rhs, x0=self._dT)
             self._dT = dT
         self._dt = h
         new = self._free(T0) + dT
         if not np.all(np.isfinite(new)):
             raise ThermalError("the heat step gave non-finite temperatures; the state is kept")
-        T = T0.copy()
+        T, T_theta = T0.copy(), T0.copy()
         T[s.rows.free_owned] = new
-        return T
+        T_theta[s.rows.free_owned] = self._free(T0) + th * dT
+        return T, T_theta
 
     def heat_content(self, reference: float = 0.0) -> float:
         """sum C (T - reference) [J] over all ranks."""

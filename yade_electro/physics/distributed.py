@@ -19,14 +19,23 @@ by :func:`carve_region_share` from the rank's *region* (its own elements and a h
 them), on which the rank's law object tessellates, once per region; the factors and the cell
 volumes (the heat capacities) of the owned elements come from there.
 
+Walls of a granular bed (YADE bodies every rank sees: under yade.mpy the master's) join the
+spheres touching them to a value held apart from the elements: a wall electrode's potential,
+an isothermal wall's temperature. Each rank gives the contacts of its own spheres
+(:meth:`DistributedElectroThermal.set_wall_contacts`); a link is a diagonal term and a right-
+hand side on its sphere's row, so the walls add no row, no column and no message.
+
+Electrodes fed an imposed current are met by superposition (one solve more per such
+electrode, each on the kept setup: :class:`~yade_electro.network.distributed.PartitionedConduction`).
+
 What it does not do (yet) raises :class:`~yade_electro.core.errors.BoundaryConditionError`
-when the engine is built: surface and wall electrodes, current-driven electrodes,
-per-material tables, heat fluxes, sources and walls.
+when the engine is built: surface electrodes, per-material tables, heat fluxes and sources.
 
 Units: SI (m, ohm m, S, V, A, W, K, J/K, W/K, s).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Dict, Optional, Sequence
@@ -43,6 +52,7 @@ from ..network.partition import LocalNetwork, split_network
 from ..solvers.partitioned import GhostExchange, mpi_comm, summed
 
 __all__ = ["Share", "carve_share", "carve_region_share", "DistributedElectroThermal", "Held", "Exchange",
+           "IsothermalWall",
            "DISTRIBUTED_LAWS", "REGION_LAWS"]
 
 #: the laws a distributed run computes
@@ -125,23 +135,53 @@ def carve_region_share(graph: Optional[ContactGraph], owner, rank: int, law) -> 
 class Held:
     """Elements held at a value: an electrode at ``value`` V or a fixed temperature at ``value``
     K, chosen by ``select`` (body ids, or a callable ``f(pos, radius) -> mask`` evaluated once on
-    the first share and then kept by id on every rank)."""
+    the first share and then kept by id on every rank). ``wall=True``: an electrode on a wall
+    of a granular bed (``select`` unused), joined to the spheres touching it through their
+    contacts (given before each call by
+    :meth:`DistributedElectroThermal.set_wall_contacts`). ``surface``: an electrode or a
+    fixed temperature on a surface of the solid (``select`` unused), joined to the elements
+    whose bounded cells have faces on it through their half cells (given once by
+    :meth:`DistributedElectroThermal.set_surface`). ``fed=True``: an electrode fed an
+    imposed current ``value`` [A] (its potential is found)."""
 
     name: str
     select: object
     value: float
+    wall: bool = False
+    fed: bool = False
+    surface: object = None
+
+    @property
+    def linked(self) -> bool:
+        """Held apart from the elements, through links (a wall or a surface)."""
+        return self.wall or self.surface is not None
+
+
+@dataclass(frozen=True)
+class IsothermalWall:
+    """A wall of a granular bed held at ``temperature`` [K], joined to the spheres touching it
+    through their contacts (the harmonic mean of the particles' conductivity and the wall's
+    ``conductivity`` [W/(m K)], None: the particles')."""
+
+    name: str
+    temperature: float
+    conductivity: Optional[float] = None
 
 
 @dataclass(frozen=True)
 class Exchange:
     """Convection ``h A (t_inf - T)`` on the elements ``select`` chose; ``area`` [m^2] a
-    scalar, or None for the exposed area of the continuum model."""
+    scalar, or None for the exposed area of the continuum model. ``surface``: on a surface
+    of the solid (``select`` and ``area`` unused), each element with boundary faces on it by
+    the area of its faces in series with its half cell (given once by
+    :meth:`DistributedElectroThermal.set_surface`)."""
 
     name: str
     select: object
     h: float
     t_inf: float
     area: Optional[float] = None
+    surface: object = None
 
 
 class DistributedElectroThermal:
@@ -154,8 +194,11 @@ class DistributedElectroThermal:
         specific_heat and conductivity (with heat).
     law : str
         One of :data:`DISTRIBUTED_LAWS`; ``law_params`` its parameters.
-    electrodes : list of Held (potentials [V])
+    electrodes : list of Held (potentials [V], or imposed currents [A] with ``fed=True``;
+        ``wall=True``: on a wall)
     fixed : list of Held (temperatures [K]); convection : list of Exchange
+    walls : list of IsothermalWall (with heat); the contacts of every wall (electrodes' and
+        isothermal ones) are given before each call by :meth:`set_wall_contacts`
     temperature : float, initial temperature [K]; None: no heat (conduction only)
     theta : the integrator's theta; eta : the share of the Joule power turned into heat;
     safety, max_substeps : the explicit sub-steps (see PartitionedHeat)
@@ -166,7 +209,7 @@ class DistributedElectroThermal:
 
     def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
-                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
+                 walls: Sequence[IsothermalWall] = (), temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
                  volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
@@ -174,12 +217,20 @@ class DistributedElectroThermal:
                                          f"{law!r} is not one of them")
         if law in REGION_LAWS:
             for item in convection:
-                if item.area is None:
+                if item.area is None and item.surface is None:
                     raise BoundaryConditionError(
                         f"convection {item.name!r} with the {law!r} law needs a scalar area= [m^2] in a distributed "
                         "run (the exposed area there is the continuum model's)")
         self.material, self.law_name = material, law
         self.law = make_law(law, **dict(law_params or {}))
+        self.walls = list(walls) if temperature is not None else []
+        if self.walls or any(e.wall for e in electrodes):
+            try:
+                self.law.wall_factor(np.ones(1), np.zeros(1))
+            except ValueError as exc:
+                raise BoundaryConditionError(f"walls with law {law!r}: {exc}") from None
+        self._contacts: Dict[str, tuple] = {}
+        self._surfaces: Dict[str, tuple] = {}    # name -> (ids, g [m] or area [m^2]) on a surface
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
         self.temperature0 = temperature
         self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
@@ -200,8 +251,95 @@ class DistributedElectroThermal:
         self.joule_energy = 0.0
 
     # -- the share and its values ------------------------------------------------------------
+    @property
+    def surface_names(self) -> dict:
+        """name -> surface of the electrodes, fixed temperatures and convections on a surface,
+        whose elements :meth:`set_surface` gives."""
+        items = list(self.electrodes) + list(self.fixed) + list(self.convection)
+        return {e.name: e.surface for e in items if e.surface is not None}
+
+    def set_surface(self, name: str, ids, values):
+        """The elements (body ids; those this rank does not own are ignored) of the surface
+        condition ``name``, kept for the run, with per element: an electrode's or a fixed
+        temperature's half-cell factor g [m] (a half cell conducts ``g / rho_e`` or
+        ``lambda g``), a convection's area [m^2] (its faces in series with the half cell)."""
+        if name not in self.surface_names:
+            raise BoundaryConditionError(f"no surface condition named {name!r}; have {sorted(self.surface_names)}")
+        ids, v = np.asarray(ids, np.int64).ravel(), np.asarray(values, float).ravel()
+        if ids.shape != v.shape or not np.all(np.isfinite(v)) or np.any(v < 0):
+            raise BoundaryConditionError(f"{name!r}: values must be finite and >= 0, one per element")
+        self._surfaces[name] = (ids, v)
+
+    def _surface_values(self, name: str, share: Share) -> np.ndarray:
+        """The values :meth:`set_surface` gave on each owned node (0 elsewhere)."""
+        g = np.zeros(share.n_owned)
+        ids, v = self._surfaces.get(name, (np.zeros(0, np.int64), np.zeros(0)))
+        if share.n_owned and ids.size:
+            on = np.isin(ids, share.owned_ids)
+            g[share.graph.index_of(ids[on])] = v[on]
+        return g
+
+    @property
+    def wall_names(self) -> list:
+        """The walls whose contacts :meth:`set_wall_contacts` takes: the electrodes' and the
+        isothermal ones."""
+        return [e.name for e in self.electrodes if e.wall] + [w.name for w in self.walls]
+
+    def set_wall_contacts(self, name: str, ids, overlap):
+        """The spheres (body ids; those this rank does not own are ignored) touching wall
+        ``name`` now and their overlaps [m] (> 0), for the next call."""
+        if name not in self.wall_names:
+            raise BoundaryConditionError(f"no wall named {name!r}; have {self.wall_names}")
+        ids, dl = np.asarray(ids, np.int64).ravel(), np.asarray(overlap, float).ravel()
+        if ids.shape != dl.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
+            raise BoundaryConditionError(f"wall {name!r}: overlaps must be finite and >= 0 (m), one per sphere")
+        self._contacts[name] = (ids, dl)
+
+    def _wall_factor(self, name: str, share: Share) -> np.ndarray:
+        """Geometric factor g [m] of each owned node's link to wall or surface ``name`` (0:
+        none): a wall's contact, a surface's half cell."""
+        n = share.n_owned
+        if name in self.surface_names:
+            return self._surface_values(name, share)
+        g = np.zeros(n)
+        ids, dl = self._contacts.get(name, (np.zeros(0, np.int64), np.zeros(0)))
+        if n and ids.size:
+            on = np.isin(ids, share.owned_ids)
+            nodes = share.graph.index_of(ids[on])
+            g[nodes] = self.law.wall_factor(share.graph.radius[nodes], dl[on])
+        return g
+
+    def _electrode_links(self, share: Share, T_owned) -> Optional[np.ndarray]:
+        """(electrodes, owned nodes) conductances [S] of the wall electrodes' contacts and the
+        surface electrodes' half cells, the element's rho_e(T); None when no electrode is on a
+        wall or a surface."""
+        if not any(e.linked for e in self.electrodes):
+            return None
+        n, m = share.n_owned, self.material
+        rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(T_owned, float))
+        links = np.zeros((len(self.electrodes), n))
+        for k, e in enumerate(self.electrodes):
+            if e.linked:
+                links[k] = self._wall_factor(e.name, share) / rho
+        return links
+
+    def _heat_links(self, share: Share):
+        """Give the heat solver each isothermal wall's contact conductances and each surface
+        fixed temperature's half-cell conductances [W/K]."""
+        lam = float(self.material.conductivity) if self.heat.link_names else 0.0
+        for w in self.walls:
+            lam_w = lam if w.conductivity is None else float(w.conductivity)
+            self.heat.set_links(w.name, 2.0 * lam * lam_w / (lam + lam_w) * self._wall_factor(w.name, share))
+        for item in self.fixed:
+            if item.surface is not None:
+                self.heat.set_links(item.name, lam * self._wall_factor(item.name, share))
+
     def _chosen(self, item, share: Share) -> np.ndarray:
         """Mask of the owned nodes ``item`` holds (its ids fixed on the first share, all ranks)."""
+        if getattr(item, "linked", False):
+            return np.zeros(share.n_owned, bool)
+        if getattr(item, "surface", None) is not None:          # a convection on a surface
+            return self._surface_values(item.name, share) > 0
         if item.name not in self._ids:
             mine = np.zeros(0, np.int64)
             if share.graph is not None:
@@ -258,6 +396,7 @@ class DistributedElectroThermal:
         of the elements kept (by id); ``factor``: the share's geometric factors when the caller
         has them."""
         self.share = share
+        old_heat = dict(self.heat.link_energy) if self.heat is not None else None
         for old in (self.conduction, self.heat):     # every rank prepares: free the old solvers together
             if old is not None:
                 old.close()
@@ -271,14 +410,9 @@ class DistributedElectroThermal:
         spacing = self._spacing(share)
         T = self._temperatures(share)
         self.T = T
+        self._pos, self._spacing_now = pos, spacing
         if self.electrodes:
-            el = np.full(n, -1, np.int64)
-            for k, item in enumerate(self.electrodes):
-                el[self._chosen(item, share)] = k
-            self.conduction = PartitionedConduction(
-                net, self._conductance(T), el, [e.name for e in self.electrodes],
-                [e.value for e in self.electrodes], comm=self.comm, preconditioner=self.preconditioner,
-                rtol=self.rtol, pos=pos, spacing=spacing, smoother=self.smoother)
+            self._new_conduction(share, T)
         if self.temperature0 is not None:
             fixed = np.full(n, np.nan)
             for item in self.fixed:
@@ -286,16 +420,52 @@ class DistributedElectroThermal:
             hA, t_inf = np.zeros(n), np.zeros(n)
             for item in self.convection:
                 on = self._chosen(item, share)
-                area = (exposed_area(share.graph)[:n] if item.area is None else np.full(n, float(item.area))) \
-                    if share.graph is not None else np.zeros(0)
+                area = self._convection_area(item, share, on)
                 t_inf[on] = (t_inf[on] * hA[on] + item.h * area[on] * item.t_inf) / np.maximum(
                     hA[on] + item.h * area[on], 1e-300)
                 hA[on] += item.h * area[on]
             self.heat = PartitionedHeat(net, self._capacity(share), self._thermal(), T,
                                         fixed=fixed, h_area=hA, t_inf=t_inf, theta=self.theta, comm=self.comm,
                                         preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing,
-                                        safety=self.safety, max_substeps=self.max_substeps, smoother=self.smoother)
+                                        safety=self.safety, max_substeps=self.max_substeps, smoother=self.smoother,
+                                        links={**{w.name: w.temperature for w in self.walls},
+                                               **{f.name: f.value for f in self.fixed if f.surface is not None}})
+            if old_heat is not None:            # the walls' heat goes on
+                for k, v in old_heat.items():
+                    self.heat.link_energy[k] = v
             self.T = self.heat.T
+
+    def _convection_area(self, item: Exchange, share: Share, on) -> np.ndarray:
+        """The area [m^2] of convection ``item`` on each owned node (used where ``on``)."""
+        n = share.n_owned
+        if share.graph is None:
+            return np.zeros(0)
+        if item.surface is not None:
+            return self._surface_values(item.name, share)
+        if item.area is None:
+            return exposed_area(share.graph)[:n]
+        return np.full(n, float(item.area))
+
+    def _new_conduction(self, share: Share, T):
+        """The conduction solve on ``share`` with the wall electrodes' contacts now (collective)."""
+        if self.conduction is not None:
+            self.conduction.close()
+        el = np.full(share.n_owned, -1, np.int64)
+        for k, item in enumerate(self.electrodes):
+            el[self._chosen(item, share)] = k
+        self.conduction = PartitionedConduction(
+            share.network, self._conductance(T), el, [e.name for e in self.electrodes], self._potentials(),
+            comm=self.comm, preconditioner=self.preconditioner, rtol=self.rtol, pos=self._pos,
+            spacing=self._spacing_now, smoother=self.smoother, links=self._electrode_links(share, T),
+            currents=self._currents())
+
+    def _potentials(self) -> list:
+        """The electrodes' potentials [V] (0 for those fed a current: found by the solve)."""
+        return [0.0 if e.fed else e.value for e in self.electrodes]
+
+    def _currents(self) -> list:
+        """The electrodes' imposed currents [A] (None for those held at a potential)."""
+        return [e.value if e.fed else None for e in self.electrodes]
 
     def _spacing(self, share: Share) -> float:
         """Mean edge length over all ranks [m] (the deflation's cluster unit)."""
@@ -344,14 +514,25 @@ class DistributedElectroThermal:
         power = np.zeros(share.n_owned)
         row: Dict[str, float] = {}
         if self.conduction is not None:
-            self.conduction.update_conductance(self._conductance(self.T))
-            self.conduction.solve([e.value for e in self.electrodes])
+            links = self._electrode_links(share, self.T)
+            if links is not None and self.comm.allreduce(int(not self.conduction.links_fit(links))):
+                self._new_conduction(share, self.T)       # spheres came to or left a wall electrode
+            self.conduction.update_conductance(self._conductance(self.T), links)
+            self.conduction.solve(self._potentials(), self._currents())
             power = self.eta * self.conduction.joule_power()
             currents = self.conduction.electrode_currents()
             row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
+            volts = self.conduction.electrode_potentials()
+            names = [e.name for e in self.electrodes]
+            # the serial engines' names: the first electrode's current, the voltage between the first two
+            row["current"] = currents[names[0]]
+            row["voltage"] = volts[names[0]] - (volts[names[1]] if len(names) > 1 else 0.0)
+            row.update({f"V_{k}": v for k, v in volts.items()})
             row.update({f"I_{k}": v for k, v in currents.items()})
             row["joule_power"] = float(summed(self.comm, np.array([power.sum()]))[0])
             row["solve_iterations"] = int(self.conduction.info["iterations"])
+        if self.heat is not None:
+            self._heat_links(share)
         if self.heat is not None and dt:
             self.T = self.heat.advance(dt, power)
             row["n_substeps"] = int(self.heat.substeps)
@@ -363,16 +544,24 @@ class DistributedElectroThermal:
             row["T_mean"] = float(summed(self.comm, np.array([self.T.sum()]))[0] / max(n_all, 1))
             row["T_max"] = self.comm.allreduce(float(self.T.max()) if self.T.size else -np.inf, op=MPI.MAX)
             row["heat_content"] = self.heat.heat_content(float(self.material.reference_temperature or 0.0))
+            flows = self.heat.link_flows()
+            for w in self.walls:
+                ids = self._contacts.get(w.name, (np.zeros(0, np.int64),))[0]
+                row[f"wall_contacts:{w.name}"] = int(self.comm.allreduce(int(np.count_nonzero(
+                    np.isin(ids, share.owned_ids)))))
+                row[f"wall_power:{w.name}"] = flows[w.name]
+                row[f"wall_heat:{w.name}"] = self.heat.link_energy[w.name]
         row["elements"] = int(self.comm.allreduce(int(share.n_owned)))
         return row
 
-    def set_electrode(self, name: str, potential: float):
-        """A new potential [V] for electrode ``name`` from the next call on (every rank)."""
+    def set_electrode(self, name: str, value: float):
+        """A new potential [V] (or imposed current [A], for an electrode fed one) for electrode
+        ``name`` from the next call on (every rank)."""
         names = [e.name for e in self.electrodes]
         if name not in names:
             raise BoundaryConditionError(f"no electrode named {name!r}; have {names}")
         k = names.index(name)
-        self.electrodes[k] = Held(name, self.electrodes[k].select, float(potential))
+        self.electrodes[k] = dataclasses.replace(self.electrodes[k], value=float(value))
 
     @property
     def potential(self) -> np.ndarray:

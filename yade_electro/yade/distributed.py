@@ -33,7 +33,7 @@ from ..core.errors import BoundaryConditionError
 from ..core.materials import Material
 from ..core.selection import check_selector
 from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedElectroThermal, Exchange, Held,
-                                   carve_region_share, carve_share)
+                                   IsothermalWall, carve_region_share, carve_share)
 from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
 from .scene import ensure_thermal_state, write_body_attribute
@@ -77,14 +77,15 @@ def _refuse(what: str):
 def distributed_model(*, solver: str, resistivity, materials, law: str, law_params: Optional[dict],
                       electrodes: Sequence = (), electrode_ids: Optional[dict] = None, heat: Optional[dict] = None,
                       conditions: Sequence = (), condition_ids: Optional[dict] = None,
-                      walls: Sequence = ()) -> DistributedElectroThermal:
+                      walls: Optional[dict] = None) -> DistributedElectroThermal:
     """The distributed model of an engine's settings, or BoundaryConditionError naming what a
     distributed run does not do. ``electrodes`` are the engine's electrode specs (name,
     select, surface, wall, potential, current); ``electrode_ids`` and ``condition_ids`` the
     body ids their selections chose when the engine was built; ``heat`` the thermal settings
     (density, specific_heat, conductivity, temperature, beta, reference_temperature, eta,
     theta, volume_fraction), None for conduction only; ``conditions`` the heat boundary
-    conditions."""
+    conditions; ``walls`` the thermal walls, name -> dict(bodies=, temperature= K or None
+    (adiabatic: conducts nothing), conductivity=)."""
     if materials is not None:
         _refuse("per-material tables (Materials): give one Material")
     comm = mpi_comm()
@@ -95,29 +96,37 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
             f"the {law!r} law runs distributed under plain mpiexec only (its tessellation needs a halo wider than "
             "yade.mpy's mirrors), and this script imports yade.mpy: run it without yade.mpy (plain mpiexec, "
             "solver='petsc'), or take law='continuum' under mp.mpirun")
-    if walls:
-        _refuse("walls (Wall, Electrode(wall=...))")
+    surfaces = [e.name for e in electrodes if e.surface is not None] + [
+        bc.name for bc in conditions if getattr(bc, "surface", None) is not None]
+    if surfaces and "yade.mpy" in sys.modules:
+        raise BoundaryConditionError(
+            f"electrodes and conditions on a surface ({surfaces}) run distributed under plain mpiexec only (their "
+            "half cells need a halo wider than yade.mpy's mirrors), and this script imports yade.mpy: run it "
+            "without yade.mpy (plain mpiexec, solver='petsc'), or select the elements with select= / nodes=")
     held = []
     for e in electrodes:
-        if e.surface is not None or e.wall:
-            _refuse(f"surface or wall electrodes (electrode {e.name!r}): select elements with select=")
-        if e.potential is None:
-            _refuse(f"current-driven electrodes (electrode {e.name!r} has current=): hold it at a potential")
-        held.append(Held(e.name, (electrode_ids or {}).get(e.name, e.select), float(e.potential)))
+        fed = e.potential is None
+        linked = e.wall or e.surface is not None
+        held.append(Held(e.name, None if linked else (electrode_ids or {}).get(e.name, e.select),
+                         float(e.current if fed else e.potential), wall=bool(e.wall), fed=fed, surface=e.surface))
+    if held and all(h.fed for h in held):
+        raise BoundaryConditionError(f"every electrode ({[h.name for h in held]}) has an imposed current: hold one at "
+                                     "a potential (potential=0, the ground) to give the current a return path")
+    isothermal = [IsothermalWall(name, float(w["temperature"]), w.get("conductivity"))
+                  for name, w in (walls or {}).items() if w.get("temperature") is not None]
     fixed, convection = [], []
     for bc in conditions:
         kind = type(bc).__name__
-        if getattr(bc, "surface", None) is not None:
-            _refuse(f"conditions at a surface ({kind} {bc.name!r}): select elements with nodes=")
-        select = (condition_ids or {}).get(bc.name, bc.nodes)
+        surface = getattr(bc, "surface", None)
+        select = None if surface is not None else (condition_ids or {}).get(bc.name, bc.nodes)
         if bc.ROLE == "fixed":
-            fixed.append(Held(bc.name, select, float(bc.field("value"))))
+            fixed.append(Held(bc.name, select, float(bc.field("value")), surface=surface))
         elif bc.ROLE == "robin":
             area = getattr(bc, "area", None)
             if area is not None and np.ndim(area) != 0:
                 _refuse(f"per-element areas ({kind} {bc.name!r}): give a scalar area or none")
             convection.append(Exchange(bc.name, select, float(bc.field("coefficient")), float(bc.field("ambient")),
-                                       None if area is None else float(area)))
+                                       None if area is None or surface is not None else float(area), surface=surface))
         else:
             _refuse(f"{kind} conditions ({bc.name!r})")
     rho = resistivity if electrodes else None
@@ -128,6 +137,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                         conductivity=h.get("conductivity"), beta=h.get("beta", 0.0) or 0.0,
                         reference_temperature=h.get("reference_temperature"))
     return DistributedElectroThermal(material, law, law_params, electrodes=held, fixed=fixed, convection=convection,
+                                     walls=isothermal,
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
                                      volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
@@ -156,10 +166,12 @@ class Slabs:
     ----------
     rank, size : this rank and the number of ranks
     hops : None, or the 'voronoi' law's hops (its wider reach, and no move check)
+    cells : the owned elements' bounded cells are made on the region (surface electrodes and
+        conditions: their half cells): the 'voronoi' law's reach with 3 hops, 5 diameters
     """
 
-    def __init__(self, rank: int, size: int, hops: Optional[int] = None):
-        self.rank, self.size, self.hops = int(rank), int(size), hops
+    def __init__(self, rank: int, size: int, hops: Optional[int] = None, cells: bool = False):
+        self.rank, self.size, self.hops, self.cells = int(rank), int(size), hops, bool(cells)
         self.axis, self._bounds, self._owner_by_id = None, None, np.zeros(0, np.int64)
         #: the halo [m], how often the region was made, the whole packing's (r_min, r_max)
         #: and (lo, hi) of its centres [m]
@@ -190,7 +202,8 @@ class Slabs:
             return np.isin(ids, self._ids)
         own = owner == self.rank
         d = 2.0 * float(np.max(radius))
-        reach = 2.0 * d if self.hops is None else max(2.0 * d, (int(self.hops) + 2) * d)
+        hops = self.hops if self.hops is not None else (3 if self.cells else None)
+        reach = 2.0 * d if hops is None else max(2.0 * d, (int(hops) + 2) * d)
         self._margin = d
         self.halo = self._scale * (reach + self._margin)
         keep = own.copy()
@@ -243,13 +256,14 @@ class Slabs:
                                      f"of {self.halo:.3g} m; their bonds reach farther than the packing's diameters")
 
 
-def slab_region(law: str, law_params: Optional[dict]) -> Optional[Slabs]:
+def slab_region(law: str, law_params: Optional[dict], cells: bool = False) -> Optional[Slabs]:
     """The :class:`Slabs` of a distributed engine under plain mpiexec (None under yade.mpy),
-    made before its first read so that no rank reads the whole scene."""
+    made before its first read so that no rank reads the whole scene; ``cells``: the engine
+    has surface electrodes or conditions (see :class:`Slabs`)."""
     if in_mpy_subdomain():
         return None
     hops = int((law_params or {}).get("hops") or 3) if law in REGION_LAWS else None
-    return Slabs(world_rank(), world_size(), hops)
+    return Slabs(world_rank(), world_size(), hops, cells=cells)
 
 
 def chosen_ids(graph, memberships: dict, what: str = "electrode", comm=None) -> dict:
@@ -304,12 +318,14 @@ class DistributedCalls:
     thermal_dt, time_scale : the thermal step of a call (fixed, or the elapsed O.time scaled)
     slabs : the Slabs the reader's first read used (plain mpiexec), or None
     graph : that first read's graph: the 'voronoi' law's faces are made on it, as a serial
-        engine makes them when it is built (the reference configuration)
+        engine makes them when it is built (the reference configuration), and the elements of
+        the surface conditions are chosen on it (:meth:`choose_surfaces`)
+    container : the solid's Shape (surface conditions)
     """
 
     def __init__(self, O, reader, model: DistributedElectroThermal, write_back: Optional[str] = None,
                  temperatures: bool = False, thermal_dt: Optional[float] = None, time_scale: float = 1.0,
-                 slabs: Optional[Slabs] = None, graph=None):
+                 slabs: Optional[Slabs] = None, graph=None, container=None):
         self.O, self.reader, self.model = O, reader, model
         self.write_back, self.temperatures = write_back, temperatures
         self.thermal_dt, self.time_scale = thermal_dt, float(time_scale)
@@ -321,6 +337,38 @@ class DistributedCalls:
         if slabs is not None and graph is not None and model.law_name in REGION_LAWS:
             model.law.radius_range, model.law.bounds = slabs.radius_range, slabs.bounds
             model.law.faces(graph)
+        if model.surface_names:
+            self.choose_surfaces(graph, container)
+
+    def choose_surfaces(self, graph, container):
+        """The elements of each surface condition and their half cells (collective): each
+        rank makes the bounded cells of its region (its slab and a halo of 5 diameters, wide
+        enough for its own elements' cells) and keeps the faces on each surface, as a serial
+        engine does on the whole packing; a surface no rank's region touches is an error."""
+        from ..geometry.boundary import BoundaryOfGraph, surface_contact
+        m = self.model
+        lam = m.material.conductivity
+        found, first_error = {}, None
+        if graph is not None:
+            law = m.law if getattr(m.law, "container", None) is container else None
+            cells, pos = BoundaryOfGraph(container, law).cells(graph)
+        for name, surface in sorted(m.surface_names.items()):
+            ids, values = np.zeros(0, np.int64), np.zeros(0)
+            if graph is not None:
+                try:
+                    c = surface_contact(cells, pos, surface, name, container=container)
+                except BoundaryConditionError as exc:     # not on this rank's region
+                    first_error = first_error or str(exc)
+                else:
+                    ids = graph.ids[c.nodes]
+                    conv = next((x for x in m.convection if x.name == name), None)
+                    values = c.factor if conv is None else c.convection_area(conv.h, lam)
+            found[name] = int(m.comm.allreduce(int(ids.size)))
+            m.set_surface(name, ids, values)
+        empty = [k for k, v in found.items() if v == 0]
+        if empty:
+            raise BoundaryConditionError(f"surface condition(s) {empty} hold no element on any rank"
+                                         + (f": {first_error}" if first_error else ""))
 
     @property
     def mode(self) -> str:
@@ -378,6 +426,9 @@ class DistributedCalls:
         owner = self._owner(graph) if graph is not None else None
         share = (carve_region_share(graph, owner, self.rank, self.model.law) if region_law
                  else carve_share(graph, owner, self.rank))
+        for name in self.model.wall_names:           # each rank's spheres on the walls it sees
+            nodes, overlap = self.reader.wall_contacts(name) if graph is not None else (np.zeros(0, np.int64), ())
+            self.model.set_wall_contacts(name, graph.ids[nodes] if graph is not None else nodes, overlap)
         self.share = share
         now = float(self.O.time)
         dt = self.thermal_dt if self.thermal_dt is not None else (now - self._last_time) * self.time_scale

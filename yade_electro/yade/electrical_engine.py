@@ -181,8 +181,9 @@ class ElectricalEngine(EngineBase):
         for s in self.model.specs:
             if s.wall:
                 place = dict(wall=list(self._electrode_walls[s.name]))
-            elif s.surface is not None:
-                place = dict(surface=self.model.surfaces[s.name].saved)
+            elif s.surface is not None:        # as chosen (a distributed run's ranks chose apart: as given)
+                m = self.model.surfaces[s.name]
+                place = dict(surface=m.saved if m.resolved else s.surface)
             else:
                 place = dict(select=np.asarray(self.model.memberships[s.name].ids, dtype=np.int64))
             out.append(Electrode(s.name, potential=s.potential, current=s.current, **place))
@@ -232,9 +233,12 @@ class ElectricalEngine(EngineBase):
         model = distributed_model(solver=self._distributed_solver(), resistivity=self._resistivity,
                                   materials=self._materials_config, law=self._options["law"],
                                   law_params=self._law_params, electrodes=self.model.specs, electrode_ids=ids,
-                                  walls=self._declared_walls)
+                                  walls=getattr(self, "_walls", None))
         return DistributedCalls(self.O, self.reader, model, write_back=self.write_back, slabs=self._slabs,
-                                graph=graph)
+                                graph=graph, container=self.container)
+
+    def _surface_names(self) -> dict:
+        return {s.name: s.surface for s in self.model.specs if s.surface is not None}
 
     def _material_base(self):
         return {"resistivity": self._resistivity}

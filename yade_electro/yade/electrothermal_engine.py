@@ -324,8 +324,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         t["materials"] = self._materials_config
         saved = []
         for bc in self.coupled.conditions + self.coupled.heat_sources:
-            if getattr(bc, "surface", None) is not None:
-                saved.append(dataclasses.replace(bc, surface=self.coupled.bc_surfaces[bc.name].saved))
+            if getattr(bc, "surface", None) is not None:      # as chosen (distributed: as given)
+                m = self.coupled.bc_surfaces[bc.name]
+                saved.append(dataclasses.replace(bc, surface=m.saved if m.resolved else bc.surface))
             elif bc.nodes is not None:
                 ids = self.coupled.bc_memberships[bc.name].ids
                 saved.append(dataclasses.replace(bc, nodes=np.asarray(ids, dtype=np.int64)))
@@ -372,10 +373,16 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                                   materials=self._materials_config, law=self._options["law"] or "continuum",
                                   law_params=self._law_params, electrodes=specs, electrode_ids=ids, heat=heat,
                                   conditions=self._heat_conditions, condition_ids=cond_ids,
-                                  walls=self._declared_walls)
+                                  walls=getattr(self, "_walls", None))
         return DistributedCalls(self.O, self.reader, model, write_back=self.write_back, temperatures=True,
                                 thermal_dt=self.thermal_dt, time_scale=self.time_scale, slabs=self._slabs,
-                                graph=graph)
+                                graph=graph, container=self.container)
+
+    def _surface_names(self) -> dict:
+        out = {s.name: s.surface for s in (self.model.specs if self.model is not None else ())
+               if s.surface is not None}
+        out.update({b.name: b.surface for b in self._heat_conditions if getattr(b, "surface", None) is not None})
+        return out
 
     def _prepare(self, graph):
         if self._resume is not None and self.model is not None:

@@ -245,7 +245,8 @@ class EngineBase(registry.RegisteredEngine):
     def _finish(self, history_mode):
         """After the model is built: first read, checks, history, runner, saved config."""
         distributed = distributed_requested(self._distributed_solver())
-        self._slabs = slab_region(self._options["law"], self._law_params) if distributed else None
+        self._slabs = slab_region(self._options["law"], self._law_params,
+                                  cells=bool(self._surface_names())) if distributed else None
         if self._slabs is not None:                 # plain mpiexec: no rank reads the whole scene
             self.reader.region = self._slabs.region
             self.reader.invalidate()
@@ -373,6 +374,11 @@ class EngineBase(registry.RegisteredEngine):
             if isinstance(name, str) and name in PETSC_SOLVERS:
                 return name
         return None
+
+    def _surface_names(self) -> dict:
+        """name -> surface of the engine's electrodes and conditions given on a surface (a
+        subclass's)."""
+        return {}
 
     def _distributed_calls(self, graph):
         """The DistributedCalls of this engine on the first ``graph`` (a subclass's)."""
