@@ -152,13 +152,13 @@ ROD_I = 200.0
 
 def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False):
     """``surface``: the electrodes and conditions on the container's faces instead of element
-    layers: the top face fed ROD_I, the bottom face grounded and held at 293 K, the side
-    cooled by convection (each element joined through its half cell, the faces chosen on each
-    rank's region)."""
+    layers: the top face fed ROD_I and 0.5 W of heat, the bottom face grounded and held at
+    293 K, the side cooled by convection (each element joined through its half cell, the faces
+    chosen on each rank's region), and a source of 1e8 W/m^3 in the whole rod."""
     from rod_resistance import RHO_304L, build_rod
     from yade_electro.geometry.shapes import as_shape
-    from yade_electro.yade import (Convection, ElectroThermalEngine, Electrode, FixedTemperature, Integrator, Law,
-                                   Material, Output)
+    from yade_electro.yade import (Convection, ElectroThermalEngine, Electrode, FixedTemperature, HeatFlux,
+                                   HeatSource, Integrator, Law, Material, Output)
     spec = build_rod(n=n, seed=1, cache_dir=cache_dir)
     ids = spec["ids"]
     mat = Material(resistivity=RHO_304L, density=7900.0, specific_heat=500.0, conductivity=16.0, beta=1e-3,
@@ -168,7 +168,8 @@ def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False):
         boundaries = [Electrode("top", surface=rod.face("top"), current=ROD_I),
                       Electrode("bottom", surface=rod.face("bottom"), potential=0.0),
                       FixedTemperature("cold", surface=rod.face("bottom"), temperature=T0),
-                      Convection("air", surface=rod.face("side"), h=2000.0, t_inf=T0)]
+                      Convection("air", surface=rod.face("side"), h=2000.0, t_inf=T0),
+                      HeatFlux("lamp", surface=rod.face("top"), power=0.5), HeatSource("core", density=1e8)]
     else:
         boundaries = [Electrode("top", select=ids[spec["top"]], potential=1.0),
                       Electrode("bottom", select=ids[spec["bottom"]], potential=0.0),
@@ -323,17 +324,25 @@ def walls_case(n=200, calls=8, period=100):
 
 def heat_case(n=200, calls=8, period=100):
     """Heat only on the bed (HeatEngine): one end held at 350 K, convection to 280 K at the other,
-    forward Euler with sub-steps (the call's step is far above the stable one); serial beside
-    distributed (``Integrator(solver='petsc')`` makes a heat engine distributed)."""
-    from yade_electro.yade import Convection, FixedTemperature, HeatEngine, Integrator, Material, Reader
+    forward Euler with sub-steps (the call's step is far above the stable one), a flux of
+    2 kW/m^2 on the exposed area of the spheres of the middle third and 20 mW from a source in
+    the last quarter, shared by volume; serial beside distributed (``Integrator(solver='petsc')``
+    makes a heat engine distributed)."""
+    from yade_electro.yade import (Convection, FixedTemperature, HeatEngine, HeatFlux, HeatSource, Integrator,
+                                   Material, Reader)
     ids, x, r = build_bed(n)
     mat = Material(density=2600.0, specific_heat=800.0, conductivity=2.0)
     left, right = ids[x < x.min() + r], ids[x > x.max() - r]
+    span = x.max() - x.min()
+    middle = ids[(x > x.min() + span / 3) & (x < x.max() - span / 3)]
+    last = ids[x > x.max() - span / 4]
 
     def make(solver, label):
         return HeatEngine(material=mat, law="contact", reader=Reader(bonds="contacts"),
                           boundaries=[FixedTemperature("hot", nodes=left, temperature=350.0),
-                                      Convection("air", nodes=right, h=50.0, t_inf=280.0, area=3e-6)],
+                                      Convection("air", nodes=right, h=50.0, t_inf=280.0, area=3e-6),
+                                      HeatFlux("lamp", nodes=middle, flux=200.0),
+                                      HeatSource("core", nodes=last, power=0.002)],
                           temperature=T0, integrator=Integrator(theta="explicit", dt=200.0, solver=solver),
                           iterPeriod=period, label=label)
     return _pair(make, calls, period, electrical=False)

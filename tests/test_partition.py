@@ -117,7 +117,7 @@ def test_voronoi_shares_of_regions_are_the_whole_tessellations(ranks):
     from yade_electro.core.graph import ContactGraph
     from yade_electro.geometry.shapes import Cylinder
     from yade_electro.laws.factors import make_law
-    from yade_electro.physics.distributed import carve_region_share
+    from yade_electro.physics.shares import carve_region_share
     rng = np.random.default_rng(5)
     R, L, h = 1e-3, 4e-3, 0.2e-3
     cyl = Cylinder((0, 0, 0), (0, 0, L), R)

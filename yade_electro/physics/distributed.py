@@ -1,6 +1,7 @@
 """Conduction, Joule heat and heat on a packing split between MPI ranks (numpy + MPI, no YADE).
 
-Each rank gives, at each call, its share of the packing as a :class:`Share`: a contact graph
+Each rank gives, at each call, its share of the packing as a
+:class:`~yade_electro.physics.shares.Share`: a contact graph
 whose first ``n_owned`` nodes are the elements it owns and the rest the ghosts they touch (other
 ranks' elements), with the edges that have an owned end. :class:`DistributedElectroThermal`
 then does what :class:`~yade_electro.physics.coupled.ElectroThermalModel` does serially, every
@@ -15,7 +16,7 @@ call collective:
 * the heat step by the theta method with fixed temperatures and convection.
 
 The 'voronoi' law's faces need a tessellation, wider than the pairs: its shares are carved
-by :func:`carve_region_share` from the rank's *region* (its own elements and a halo around
+by :func:`~yade_electro.physics.shares.carve_region_share` from the rank's *region* (its own elements and a halo around
 them), on which the rank's law object tessellates, once per region; the factors and the cell
 volumes (the heat capacities) of the owned elements come from there.
 
@@ -29,7 +30,7 @@ Electrodes fed an imposed current are met by superposition (one solve more per s
 electrode, each on the kept setup: :class:`~yade_electro.network.distributed.PartitionedConduction`).
 
 What it does not do (yet) raises :class:`~yade_electro.core.errors.BoundaryConditionError`
-when the engine is built: surface electrodes, per-material tables, heat fluxes and sources.
+when the engine is built: per-material tables.
 
 Units: SI (m, ohm m, S, V, A, W, K, J/K, W/K, s).
 """
@@ -43,92 +44,21 @@ from typing import Dict, Optional, Sequence
 import numpy as np
 
 from ..core.errors import BoundaryConditionError
-from ..core.graph import ContactGraph
 from ..core.materials import Material, electrical_conductance, thermal_conductance_of
 from ..laws.factors import edge_lengths, is_contact_law, make_law
 from ..laws.transmission import exposed_area, transmission_surface, volume_fraction
 from ..network.distributed import PartitionedConduction, PartitionedHeat
-from ..network.partition import LocalNetwork, split_network
 from ..solvers.partitioned import GhostExchange, mpi_comm, summed
+from .shares import Share
 
-__all__ = ["Share", "carve_share", "carve_region_share", "DistributedElectroThermal", "Held", "Exchange",
-           "IsothermalWall",
-           "DISTRIBUTED_LAWS", "REGION_LAWS"]
+__all__ = ["DistributedElectroThermal", "Held", "Exchange", "IsothermalWall", "Feed", "DISTRIBUTED_LAWS",
+           "REGION_LAWS"]
 
 #: the laws a distributed run computes
 DISTRIBUTED_LAWS = ("continuum", "contact", "liggghts", "pipe", "voronoi")
-#: the laws whose shares are carved from a region with a halo (:func:`carve_region_share`)
+#: the laws whose shares are carved from a region with a halo
+#: (:func:`~yade_electro.physics.shares.carve_region_share`)
 REGION_LAWS = ("voronoi",)
-
-
-@dataclass(frozen=True, eq=False)
-class Share:
-    """One rank's share of the packing: ``graph`` (owned nodes first, then ghosts; None when
-    the rank owns nothing) and its ``network`` (the same nodes and edges, with the ghosts'
-    owners)."""
-
-    graph: Optional[ContactGraph]
-    network: LocalNetwork
-    #: the geometric factors [m] of the edges when the carving computed them (the 'voronoi'
-    #: law, on the rank's region), else None (computed on the share)
-    factor: Optional[np.ndarray] = None
-    #: the owned elements' cell volumes [m^3] when the law has cells ('voronoi'), else None
-    volume: Optional[np.ndarray] = None
-
-    @property
-    def n_owned(self) -> int:
-        return self.network.n_owned
-
-    @property
-    def owned_ids(self) -> np.ndarray:
-        return self.network.owned_key
-
-    def conducting(self, keep) -> "Share":
-        """The share with only the edges ``keep`` (a mask): contacts that touch; the nodes stay."""
-        keep = np.asarray(keep, dtype=bool)
-        if self.graph is None or np.all(keep):
-            return self
-        net = self.network
-        graph = self.graph.with_edges(self.graph.edges[keep])
-        return Share(graph, LocalNetwork(net.owned_key, net.ghost_key, net.ghost_owner, graph.edges))
-
-
-def _carve(graph, owner, rank):
-    owner = np.asarray(owner, dtype=np.int64)
-    network, held = split_network(graph.n_nodes, graph.edges, owner, rank, keys=graph.ids)
-    if network.n_owned == 0:
-        return Share(None, network), held, None
-    nodes = np.concatenate([np.flatnonzero(owner == rank), graph.index_of(network.ghost_key)])
-    sub = ContactGraph(graph.pos[nodes], graph.radius[nodes], network.edges, ids=graph.ids[nodes],
-                       revision=graph.revision)
-    return Share(sub, LocalNetwork(network.owned_key, network.ghost_key, network.ghost_owner, sub.edges)), held, nodes
-
-
-def carve_share(graph: Optional[ContactGraph], owner, rank: int) -> Share:
-    """The share of rank ``rank`` of a graph of the elements it has (the whole packing, or its
-    own and mirrored ones), ``owner[i]`` the rank owning node i. The share's edges are the
-    graph's edges with an owned end, in the graph's order."""
-    if graph is None:
-        return Share(None, LocalNetwork([], [], [], np.zeros((0, 2), np.int64)))
-    return _carve(graph, owner, rank)[0]
-
-
-def carve_region_share(graph: Optional[ContactGraph], owner, rank: int, law) -> Share:
-    """The share of rank ``rank`` for a law whose network and factors need a neighbourhood
-    wider than the pairs (the 'voronoi' law: a tessellation): ``graph`` is the rank's region
-    (the elements it owns and a halo around them, with their bonds), ``law`` the rank's law
-    object, which keeps the region's tessellation. The share's edges are the law's conducting
-    pairs with an owned end; its ``factor`` and ``volume`` are the region's values, exact for
-    the owned elements when the halo holds every element their cells and crack rule see."""
-    if graph is None:
-        return carve_share(None, None, rank)
-    pairs = np.asarray(law.network(graph), dtype=np.int64).reshape(-1, 2)
-    factor = law.factor(graph, pairs)
-    share, held, nodes = _carve(graph.with_edges(pairs), owner, rank)
-    if share.graph is None:
-        return share
-    volume = law.cell_volumes(graph)[nodes[:share.n_owned]] if hasattr(law, "cell_volumes") else None
-    return Share(share.graph, share.network, factor=np.asarray(factor, float)[held], volume=volume)
 
 
 @dataclass(frozen=True)
@@ -155,6 +85,25 @@ class Held:
     def linked(self) -> bool:
         """Held apart from the elements, through links (a wall or a surface)."""
         return self.wall or self.surface is not None
+
+
+@dataclass(frozen=True)
+class Feed:
+    """Heat fed into the elements ``select`` chose (None: every element), as
+    :class:`~yade_electro.network.heat_conditions.HeatFlux` (``kind='flux'``) or
+    :class:`~yade_electro.network.heat_conditions.HeatSource` (``kind='source'``) do serially:
+    ``rate`` [W] in total, shared over all ranks in proportion to the weights (a flux: equal
+    shares, or its scalar ``area``, or on a ``surface`` its boundary faces' areas; a source: the
+    elements' volumes), or ``density`` [W/m^2 or W/m^3] times each weight (a flux: its
+    ``area``, None for the exposed area; a source: the volumes). Held elements take none."""
+
+    name: str
+    select: object
+    kind: str
+    rate: Optional[float] = None
+    density: Optional[float] = None
+    area: Optional[float] = None
+    surface: object = None
 
 
 @dataclass(frozen=True)
@@ -199,6 +148,7 @@ class DistributedElectroThermal:
     fixed : list of Held (temperatures [K]); convection : list of Exchange
     walls : list of IsothermalWall (with heat); the contacts of every wall (electrodes' and
         isothermal ones) are given before each call by :meth:`set_wall_contacts`
+    feeds : list of Feed (heat fluxes and sources, with heat)
     temperature : float, initial temperature [K]; None: no heat (conduction only)
     theta : the integrator's theta; eta : the share of the Joule power turned into heat;
     safety, max_substeps : the explicit sub-steps (see PartitionedHeat)
@@ -209,7 +159,8 @@ class DistributedElectroThermal:
 
     def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
-                 walls: Sequence[IsothermalWall] = (), temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
+                 walls: Sequence[IsothermalWall] = (), feeds: Sequence[Feed] = (),
+                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
                  volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
@@ -224,6 +175,10 @@ class DistributedElectroThermal:
         self.material, self.law_name = material, law
         self.law = make_law(law, **dict(law_params or {}))
         self.walls = list(walls) if temperature is not None else []
+        self.feeds = list(feeds) if temperature is not None else []
+        self._fed = None                          # the feeds' power [W] per owned node
+        self._read_graph = None                   # the last share's graph as read (before the contacts' filter)
+        self.flux_energy = 0.0
         if self.walls or any(e.wall for e in electrodes):
             try:
                 self.law.wall_factor(np.ones(1), np.zeros(1))
@@ -255,7 +210,7 @@ class DistributedElectroThermal:
     def surface_names(self) -> dict:
         """name -> surface of the electrodes, fixed temperatures and convections on a surface,
         whose elements :meth:`set_surface` gives."""
-        items = list(self.electrodes) + list(self.fixed) + list(self.convection)
+        items = list(self.electrodes) + list(self.fixed) + list(self.convection) + list(self.feeds)
         return {e.name: e.surface for e in items if e.surface is not None}
 
     def set_surface(self, name: str, ids, values):
@@ -338,8 +293,10 @@ class DistributedElectroThermal:
         """Mask of the owned nodes ``item`` holds (its ids fixed on the first share, all ranks)."""
         if getattr(item, "linked", False):
             return np.zeros(share.n_owned, bool)
-        if getattr(item, "surface", None) is not None:          # a convection on a surface
+        if getattr(item, "surface", None) is not None:          # a convection or a flux on a surface
             return self._surface_values(item.name, share) > 0
+        if item.select is None:                                # a source on every element
+            return np.ones(share.n_owned, bool)
         if item.name not in self._ids:
             mine = np.zeros(0, np.int64)
             if share.graph is not None:
@@ -430,10 +387,36 @@ class DistributedElectroThermal:
                                         safety=self.safety, max_substeps=self.max_substeps, smoother=self.smoother,
                                         links={**{w.name: w.temperature for w in self.walls},
                                                **{f.name: f.value for f in self.fixed if f.surface is not None}})
+            self._fed = self._feed_power(share, fixed)
             if old_heat is not None:            # the walls' heat goes on
                 for k, v in old_heat.items():
                     self.heat.link_energy[k] = v
             self.T = self.heat.T
+
+    def _feed_power(self, share: Share, fixed) -> np.ndarray:
+        """The feeds' power [W] on each owned node, held ones excluded (collective)."""
+        n, m = share.n_owned, self.material
+        q = np.zeros(n)
+        for f in self.feeds:
+            on = self._chosen(f, share)
+            if f.kind == "source":
+                w = self._capacity(share) / (m.density * m.specific_heat) if n else np.zeros(0)
+            elif f.surface is not None:
+                w = self._surface_values(f.name, share)
+            elif f.rate is not None or f.area is not None:
+                w = np.full(n, 1.0 if f.area is None else float(f.area))
+            else:
+                w = self._exposed_area(share)
+            if f.rate is not None:
+                total = float(summed(self.comm, np.array([w[on].sum() if n else 0.0]))[0])
+                if not total > 0:
+                    raise BoundaryConditionError(f"{f.name!r}: its elements' {'volumes' if f.kind == 'source' else 'areas'} "
+                                                 "sum to 0 over the ranks")
+                q[on] += f.rate * w[on] / total
+            else:
+                q[on] += f.density * w[on]
+        q[~np.isnan(fixed)] = 0.0
+        return q
 
     def _convection_area(self, item: Exchange, share: Share, on) -> np.ndarray:
         """The area [m^2] of convection ``item`` on each owned node (used where ``on``)."""
@@ -443,8 +426,17 @@ class DistributedElectroThermal:
         if item.surface is not None:
             return self._surface_values(item.name, share)
         if item.area is None:
-            return exposed_area(share.graph)[:n]
+            return self._exposed_area(share)
         return np.full(n, float(item.area))
+
+    def _exposed_area(self, share: Share) -> np.ndarray:
+        """The default exposed area [m^2] of each owned node, from the graph as read (a bed's
+        Verlet pairs, touching or not, as the serial model takes it), not from the contacts
+        that conduct: both runs then agree."""
+        g = self._read_graph
+        if g is None or g.n_nodes != (share.graph.n_nodes if share.graph is not None else 0):
+            g = share.graph
+        return exposed_area(g)[:share.n_owned] if share.n_owned else np.zeros(0)
 
     def _new_conduction(self, share: Share, T):
         """The conduction solve on ``share`` with the wall electrodes' contacts now (collective)."""
@@ -492,6 +484,7 @@ class DistributedElectroThermal:
         values are refreshed in place): the potential, the Joule heat, and a heat step of
         ``dt`` [s] (None or 0: no heat step). Returns the totals of all ranks."""
         factor = share.factor
+        self._read_graph = share.graph           # its edges: the default exposed areas' (as serially)
         if is_contact_law(self.law_name) and share.graph is not None:   # pair factors: once, on all contacts
             factor = self.law.factor(share.graph, share.graph.edges)
             touching = factor > 0
@@ -534,6 +527,9 @@ class DistributedElectroThermal:
         if self.heat is not None:
             self._heat_links(share)
         if self.heat is not None and dt:
+            if self._fed is not None and self.feeds:
+                power = power + self._fed
+                self.flux_energy += float(summed(self.comm, np.array([self._fed.sum()]))[0]) * dt
             self.T = self.heat.advance(dt, power)
             row["n_substeps"] = int(self.heat.substeps)
             self.time += dt
@@ -544,6 +540,8 @@ class DistributedElectroThermal:
             row["T_mean"] = float(summed(self.comm, np.array([self.T.sum()]))[0] / max(n_all, 1))
             row["T_max"] = self.comm.allreduce(float(self.T.max()) if self.T.size else -np.inf, op=MPI.MAX)
             row["heat_content"] = self.heat.heat_content(float(self.material.reference_temperature or 0.0))
+            if self.feeds:
+                row["flux_heat"] = self.flux_energy
             flows = self.heat.link_flows()
             for w in self.walls:
                 ids = self._contacts.get(w.name, (np.zeros(0, np.int64),))[0]

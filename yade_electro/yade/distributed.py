@@ -7,15 +7,17 @@ Two ways to run, one user script:
   the bodies with ``b.subdomain == r`` and sees the bodies of other subdomains it mirrors
   (``O.subD.mirrorIntersections``); the master (rank 0) owns no sphere and takes part in the
   solves with an empty share. Electrodes and fixed temperatures chosen when the engine is
-  built work wherever their elements end up.
+  built work wherever their elements end up; walls are the master's bodies, which every
+  worker sees: each joins its own spheres on them.
 * **Plain mpiexec** (every rank runs the whole scene, as YADE does without ``mpy``): each rank
   owns a slab of the packing along its longest axis (equal counts, fixed by body id at the
   first read; bodies added later go by position) and reads only its *region*, the slab and a
   halo around it (:class:`Slabs`), from the engine's first read on. The mechanics are YADE's,
   replicated; the network is not: each rank reads, builds, holds and solves only its share.
-  The 'voronoi' law runs here only: each rank tessellates its region.
+  The 'voronoi' law and surface conditions run here only: each rank tessellates its region
+  (:meth:`DistributedCalls.choose_surfaces`).
 
-Each call: read the scene, carve this rank's share (:func:`~yade_electro.physics.distributed.carve_share`),
+Each call: read the scene, carve this rank's share (:func:`~yade_electro.physics.shares.carve_share`),
 advance :class:`~yade_electro.physics.distributed.DistributedElectroThermal` (collective),
 write potentials and temperatures back to the rank's own bodies, and append the totals as a
 history row (the CSV is written by rank 0 only). What a distributed run does not do raises when
@@ -32,8 +34,9 @@ import numpy as np
 from ..core.errors import BoundaryConditionError
 from ..core.materials import Material
 from ..core.selection import check_selector
-from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedElectroThermal, Exchange, Held,
-                                   IsothermalWall, carve_region_share, carve_share)
+from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedElectroThermal, Exchange, Feed, Held,
+                                   IsothermalWall)
+from ..physics.shares import carve_region_share, carve_share
 from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
 from .scene import ensure_thermal_state, write_body_attribute
@@ -114,7 +117,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                                      "a potential (potential=0, the ground) to give the current a return path")
     isothermal = [IsothermalWall(name, float(w["temperature"]), w.get("conductivity"))
                   for name, w in (walls or {}).items() if w.get("temperature") is not None]
-    fixed, convection = [], []
+    fixed, convection, feeds = [], [], []
     for bc in conditions:
         kind = type(bc).__name__
         surface = getattr(bc, "surface", None)
@@ -127,6 +130,14 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                 _refuse(f"per-element areas ({kind} {bc.name!r}): give a scalar area or none")
             convection.append(Exchange(bc.name, select, float(bc.field("coefficient")), float(bc.field("ambient")),
                                        None if area is None or surface is not None else float(area), surface=surface))
+        elif bc.ROLE in ("injection", "source"):
+            area = getattr(bc, "area", None)
+            if area is not None and np.ndim(area) != 0:
+                _refuse(f"per-element areas ({kind} {bc.name!r}): give a scalar area or none")
+            rate, density = bc.field("rate"), bc.field("density")
+            feeds.append(Feed(bc.name, select, "flux" if bc.ROLE == "injection" else "source",
+                              None if rate is None else float(rate), None if density is None else float(density),
+                              None if area is None or surface is not None else float(area), surface=surface))
         else:
             _refuse(f"{kind} conditions ({bc.name!r})")
     rho = resistivity if electrodes else None
@@ -137,7 +148,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                         conductivity=h.get("conductivity"), beta=h.get("beta", 0.0) or 0.0,
                         reference_temperature=h.get("reference_temperature"))
     return DistributedElectroThermal(material, law, law_params, electrodes=held, fixed=fixed, convection=convection,
-                                     walls=isothermal,
+                                     walls=isothermal, feeds=feeds,
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
                                      volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
@@ -362,7 +373,8 @@ class DistributedCalls:
                 else:
                     ids = graph.ids[c.nodes]
                     conv = next((x for x in m.convection if x.name == name), None)
-                    values = c.factor if conv is None else c.convection_area(conv.h, lam)
+                    fed = any(x.name == name for x in m.feeds)
+                    values = c.area if fed else (c.factor if conv is None else c.convection_area(conv.h, lam))
             found[name] = int(m.comm.allreduce(int(ids.size)))
             m.set_surface(name, ids, values)
         empty = [k for k, v in found.items() if v == 0]
