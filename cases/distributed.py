@@ -12,6 +12,10 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     distributed one: the reference is exact and on the same geometry.
 ``rod-continuum``
     The same with the continuum law.
+``rod-surface-voronoi``, ``rod-surface-continuum``
+    The rod with its electrodes and conditions on the container's faces: the top face fed
+    ROD_I and 0.5 W of heat, the bottom face grounded and held at 293 K, convection on the
+    side, a source in the whole rod (each rank chooses the faces' elements on its region).
 ``bed``
     A granular bed settling on a floor under gravity (hexagonal lattice, contact law), Joule-
     heated between its two ends, one end at 293 K, Crank-Nicolson, serial engine beside the
@@ -24,6 +28,9 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
 ``pin-voronoi``
     The same with the 'voronoi' law and crack facets (the broken bonds' facets cut the faces
     across them), on the same end layers (surface electrodes are not distributed).
+``walls``
+    The bed with its floor as a wall electrode (grounded) and an isothermal wall (280 K), the
+    left end fed WALLS_I: the links of the spheres on the floor, against serial.
 ``heat``
     Heat only on the bed (HeatEngine, made distributed by ``Integrator(solver='petsc')``): one end
     at 350 K, convection to 280 K at the other, forward Euler with sub-steps. Plain mpiexec.
@@ -33,6 +40,10 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     the serial ones (measured: 3.1e-5 m apart after 1,000 steps with no engine at all), so the
     reference here is a serial solve on the geometry the workers had at the last call: R_eq,
     electrode currents and potentials.
+``mpy-walls``
+    The same with walls_engine's electrodes: the floor, a body of yade.mpy's master, is the
+    wall electrode and the isothermal wall every worker joins its spheres to. One of ``mpy``
+    and ``mpy-walls`` per run (yade.mpy splits the scene for good).
 
 ``max_rel_diff``: the worst over the cases of R_eq, electrode currents, potentials (over the
 applied voltage) and temperature rises (over the largest rise).

@@ -272,9 +272,14 @@ def test_history_writes_the_csv_row_by_row(tmp_path):
     df = h.to_dataframe()
     assert list(df.columns) == ["iter", "R_eq", "I"] and len(df) == 3
     assert df["R_eq"].iloc[0] == 1.0 / 3.0 and np.isinf(df["R_eq"].iloc[1])
-    with pytest.raises(ValueError, match="differ from the columns"):
-        h.append({"iter": 30, "R_eq": 1.0})
-    assert len(read_csv(path)) == 4                            # the bad row was not written
+    h.append({"iter": 30, "R_eq": 1.0})                       # a row without I: nan there
+    lines = read_csv(path)
+    assert len(lines) == 5 and lines[-1] == ["30", "1.0", "nan"]
+    h.append({"iter": 40, "R_eq": 2.0, "I": 0.5, "steps": 3})  # a new key: a wider header, the file again
+    lines = read_csv(path)
+    assert lines[0] == ["iter", "R_eq", "I", "steps"] and len(lines) == 6
+    assert lines[1][3] == "nan" and lines[-1] == ["40", "2.0", "0.5", "3"]
+    assert np.isnan(h.column("steps")[0]) and h.column("steps")[-1] == 3
 
 
 def test_history_starts_a_fresh_file_and_can_stay_in_memory(tmp_path):

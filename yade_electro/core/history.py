@@ -25,6 +25,9 @@ __all__ = ["History"]
 log = logging.getLogger(__name__)
 
 
+_NAN = float("nan")
+
+
 def _fmt(v):
     if isinstance(v, float):
         return repr(v)
@@ -44,7 +47,10 @@ def _parse(v: str):
 class History:
     """Rows of figures in memory, and in a CSV file when ``path`` is given.
 
-    The columns are fixed by the first row; later rows with other keys raise ValueError.
+    The columns are the first row's keys; a later row with a key not seen yet adds its column
+    (the file is written again with the wider header, earlier rows empty there: ``nan``), and
+    a row without a column's key has ``nan`` there (a steady solve's row after time steps,
+    or the other way round).
 
     Parameters
     ----------
@@ -63,6 +69,7 @@ class History:
         self._fields: Optional[List[str]] = None
         self._file_ok = True          # False after a failed write: rewrite everything when it works again
         self._written = 0             # rows of self.rows that are in the file
+        self._widened = False         # a row added columns: rewrite the file with the wider header
         if self.path:
             exists = os.path.exists(self.path) and os.path.getsize(self.path) > 0
             if mode == "x" and exists:
@@ -112,7 +119,7 @@ class History:
                 w = csv.writer(fh)
                 w.writerow(self._fields)
                 for r in self.rows:
-                    w.writerow([_fmt(r[k]) for k in self._fields])
+                    w.writerow([_fmt(r.get(k, _NAN)) for k in self._fields])
 
         def append():
             with open(self.path, "a", newline="") as fh:
@@ -120,15 +127,15 @@ class History:
                 if self._written == 0 and fh.tell() == 0:
                     w.writerow(self._fields)
                 for r in self.rows[self._written:]:
-                    w.writerow([_fmt(r[k]) for k in self._fields])
-        if not self._file_ok or not os.path.exists(self.path):
+                    w.writerow([_fmt(r.get(k, _NAN)) for k in self._fields])
+        if not self._file_ok or self._widened or not os.path.exists(self.path):
             ok = self._try(rewrite)
         else:
             ok = self._try(append)
         if ok:
             if not self._file_ok:
                 log.warning("history file %s written again (%d rows)", self.path, len(self.rows))
-            self._file_ok = True
+            self._file_ok, self._widened = True, False
             self._written = len(self.rows)
 
     # -- rows ----------------------------------------------------------------------------------
@@ -141,8 +148,11 @@ class History:
         row = dict(row)
         if self._fields is None:
             self._fields = list(row)
-        elif set(row) != set(self._fields):
-            raise ValueError(f"history row keys {sorted(row)} differ from the columns {self._fields}")
+        else:
+            new = [k for k in row if k not in self._fields]
+            if new:                       # a wider header: the whole file is written again
+                self._fields = self._fields + new
+                self._widened = True
         self.rows.append(row)
         if self.path:
             self._write_pending()
@@ -162,7 +172,7 @@ class History:
         return len(self.rows)
 
     def column(self, name: str) -> np.ndarray:
-        return np.array([r[name] for r in self.rows])
+        return np.array([r.get(name, _NAN) for r in self.rows])
 
     def to_dataframe(self):
         """The history as a pandas DataFrame (pandas is imported only here)."""

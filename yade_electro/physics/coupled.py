@@ -31,6 +31,7 @@ Units: SI; temperatures in K (or degC if T_0 and every temperature are in degC).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 from typing import Mapping, Optional, Sequence
 
@@ -46,6 +47,7 @@ from ..core.materials import Material, real_number, thermal_conductance_of
 from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
 from ..network.boundary import FixedValue
+from ..network.lumping import LumpedHeatSolver, Lumping
 from ..network.transient import HeatSolver
 from .thermal import (diffusion_time_step, heat_capacity, heat_material, source_power, split_heat_boundaries,
                       surface_conditions)
@@ -105,13 +107,15 @@ class ElectroThermalModel:
     cell_volume : scalar or callable(graph) -> (n,), optional
         The volume each element stands for [m^3] (see
         :func:`~yade_electro.physics.thermal.heat_capacity`).
+    lumps : callable(graph) -> (n,) clump label per element (-1: none), optional
+        One temperature per clump (:class:`~yade_electro.network.lumping.LumpedHeatSolver`).
     history : History or path, optional
         Every row returned by ``step`` is appended to it.
     """
 
     def __init__(self, electrical: Optional[ElectricalModel], material: Material, temperature: float, *,
                  integrator: Integrator = Integrator(), boundaries: Sequence = (), law=None, area=None,
-                 cell_volume=None, history=None):
+                 cell_volume=None, lumps=None, history=None):
         if electrical is not None and not isinstance(electrical, ElectricalModel):
             raise TypeError("electrical must be an ElectricalModel (yade_electro.physics.electrical) or None")
         if not isinstance(material, Material):
@@ -164,7 +168,7 @@ class ElectroThermalModel:
         if cell_volume is None and volume_fraction is None and hasattr(self.network.law, "cell_volumes"):
             # the capacities that go with Voronoi conductances: the cells fill the solid
             cell_volume = self.network.law.cell_volumes
-        self.area, self.volume_fraction, self.cell_volume = area, volume_fraction, cell_volume
+        self.area, self.volume_fraction, self.cell_volume, self.lumps = area, volume_fraction, cell_volume, lumps
         self.coupling_iterations = int(integrator.coupling_iterations)
         self.coupling_tol = float(integrator.coupling_tol)
         self.resistivity_tol = real_number("resistivity_tol", integrator.resistivity_tol)
@@ -327,11 +331,12 @@ class ElectroThermalModel:
         capacity = self._capacities(graph)
         area = self.area(graph) if callable(self.area) else self.area
         self._walls_applied = None
-        self.heat = HeatSolver(capacity, self.network.edges, self._thermal_conductance(graph), T,
-                               conditions=conditions, time=time,
-                               energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
-                               link_of=link_of, power=self._source_power(graph), coords=graph.pos,
-                               **self.heat_options)
+        labels = self.lumps(graph) if self.lumps is not None else None
+        solver = HeatSolver if labels is None or not np.any(np.asarray(labels) >= 0) else \
+            functools.partial(LumpedHeatSolver, Lumping.of(labels))
+        self.heat = solver(capacity, self.network.edges, self._thermal_conductance(graph), T, conditions=conditions,
+                           time=time, energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
+                           link_of=link_of, power=self._source_power(graph), coords=graph.pos, **self.heat_options)
         self._ids = graph.ids.copy()
         self._rho_solved = None
         self.n_rebuilds += 1

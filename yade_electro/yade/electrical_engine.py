@@ -104,10 +104,11 @@ class ElectricalEngine(EngineBase):
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, container=None, skin="auto", materials=None, O=None, _resume=None):
+                 reselect: bool = False, container=None, skin="auto", materials=None, clumps=None, O=None,
+                 _resume=None):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
-                              skin=skin, walls=electrode_walls(electrodes) or None)
+                              skin=skin, walls=electrode_walls(electrodes) or None, clumps=clumps)
         self._options_bonds = bonds
         self._electrode_walls = electrode_walls(electrodes)
         self._declared_walls = list(self._electrode_walls)
@@ -204,7 +205,7 @@ class ElectricalEngine(EngineBase):
                     bonds=o["bonds"], mask=o["mask"], geometry_every=o["geometry_every"],
                     move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                     bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
-                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"],
+                    plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"], clumps=o["clumps"],
                     materials=self._materials_config)
 
     def _save_state(self):

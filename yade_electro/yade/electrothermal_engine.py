@@ -18,6 +18,7 @@ from ..network.heat_conditions import ThermalWall
 from . import persistence
 from . import registry
 from .runtime import import_yade
+from .clumps import clump_volume_fraction, write_clump_temperatures
 from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
@@ -109,7 +110,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
                  label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
-                 materials=None, overlap=False, O=None, _resume=None):
+                 materials=None, overlap=False, clumps=None, O=None, _resume=None):
         if not isinstance(overlap, bool):
             raise ValueError(f"overlap must be True or False, got {overlap!r}")
         if overlap and (electrodes is not None or bonds != "contacts"):
@@ -125,7 +126,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         wall_specs = self._wall_specs(walls)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
-                              skin=skin, walls={w.name: ids for w, ids in wall_specs if w.isothermal} or None)
+                              skin=skin, walls={w.name: ids for w, ids in wall_specs if w.isothermal} or None,
+                              clumps=clumps)
         self._electrode_walls = electrode_walls(electrodes)
         clash = set(self._electrode_walls) & {w.name for w, _ in wall_specs}
         if clash:
@@ -180,6 +182,10 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         volume_fraction = extra.pop("volume_fraction", None)
         if bonds == "contacts" and "cell_volume" not in extra and volume_fraction is None:
             volume_fraction = 1.0                        # a particle is its own volume
+            if clumps is not None:                       # a clump's members: their shares of its volume
+                volume_fraction = clump_volume_fraction(self.reader)
+        if bonds == "contacts" and clumps == "lumped":
+            extra.setdefault("lumps", lambda graph: self.reader.clump_labels(graph.ids))
         integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
                                 **{k: extra.pop(k) for k in MODEL_OPTIONS if k in extra})
         heat_material = Material(density=density, specific_heat=specific_heat, conductivity=conductivity,
@@ -321,6 +327,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         t = dict(self._thermal)
         t["walls"] = dict(self._walls) or None
         t["skin"] = self._options["skin"]
+        t["clumps"] = self._options["clumps"]
         t["materials"] = self._materials_config
         saved = []
         for bc in self.coupled.conditions + self.coupled.heat_sources:
@@ -428,6 +435,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         self._last_time = float(self.O.time)
         bodies = self.reader.bodies
         self._temperature_writer.write(bodies, self.coupled.temperature)
+        if getattr(self.reader, "has_clumps", False):       # and on each clump body: its members' mean
+            write_clump_temperatures(self.O, self.reader, graph.ids, self.coupled.temperature, self.coupled.capacity)
         sol = self.coupled.solution
         if self.write_back and sol is not None and sol is not self._written:
             write_body_attribute(bodies, self.write_back, sol.potential)

@@ -187,10 +187,10 @@ class EngineBase(registry.RegisteredEngine):
         self.label = label if resume is not None else registry.claim_label(label, self.DEFAULT_LABEL, self.O)
         self.iterPeriod = check_period(iterPeriod)
         opts = dict(reader_options)
-        skin, walls = opts.pop("skin", "auto"), opts.pop("walls", None)
+        skin, walls, clumps = opts.pop("skin", "auto"), opts.pop("walls", None), opts.pop("clumps", None)
         if opts["bonds"] == "contacts":
             self._reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls,
-                                          periodic=self._heat_only)
+                                          periodic=self._heat_only, clumps=clumps is not None)
         else:
             if self._declared_walls:
                 raise BoundaryConditionError("walls (Wall, or Electrode(wall=...)) conduct in the granular mode "

@@ -163,6 +163,9 @@ class GranularReader:
         Take periodic cells (default False: a periodic scene raises GraphError). The heat-only
         engines take them; the engines with electrodes do not (an electrode selected by
         position, or a wall, is not defined across the cell's images here).
+    clumps : bool
+        Read clump members as spheres, each with its clump (:meth:`clump_labels`); False:
+        clumps are left out, with a warning.
 
     Attributes
     ----------
@@ -182,7 +185,7 @@ class GranularReader:
     GROW_BELOW, SHRINK_FROM = 6, 30
 
     def __init__(self, O=None, mask: Optional[int] = None, skin="auto", walls: Optional[Dict] = None,
-                 periodic: bool = False):
+                 periodic: bool = False, clumps: bool = False):
         self.adaptive = isinstance(skin, str) and skin == "auto"
         if self.adaptive:
             skin = self.SKIN_START
@@ -211,6 +214,8 @@ class GranularReader:
         self._wall_contacts: Dict[str, tuple] = {}
         self.periodic = False
         self.accepts_periodic = bool(periodic)
+        self.clumps = bool(clumps)
+        self._clump_ids = self._clump_of = np.zeros(0, np.int64)     # body ids (sorted) -> clump ids
         #: ``keep(ids, pos, radius) -> mask``: read only the spheres of a region (see
         #: :func:`~yade_electro.yade.scene.read_spheres`); None: all
         self.region = None
@@ -272,6 +277,22 @@ class GranularReader:
                                for name in self.walls}
         return self.graph
 
+    @property
+    def has_clumps(self) -> bool:
+        """True when the last full read found clump members."""
+        return bool(np.any(self._clump_of >= 0))
+
+    def clump_labels(self, ids) -> np.ndarray:
+        """The clump body id of each sphere of body ids ``ids`` (-1: not in a clump), as at the
+        last full read (the element set changes only there)."""
+        ids = np.asarray(ids, np.int64)
+        out = np.full(ids.shape, -1, np.int64)
+        if self._clump_ids.size:
+            at = np.minimum(np.searchsorted(self._clump_ids, ids), self._clump_ids.size - 1)
+            found = self._clump_ids[at] == ids
+            out[found] = self._clump_of[at[found]]
+        return out
+
     def wall_contacts(self, name: str):
         """(nodes, overlaps [m]) of the spheres touching wall ``name`` at the last read."""
         return self._wall_contacts[name]
@@ -309,7 +330,11 @@ class GranularReader:
         return None
 
     def _full_read(self):
-        spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic, keep=self.region)
+        spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic, keep=self.region,
+                               clumps=self.clumps)
+        if spheres.clump is not None:
+            order = np.argsort(spheres.ids)
+            self._clump_ids, self._clump_of = spheres.ids[order], spheres.clump[order]
         self.periodic = bool(self.O.periodic)
         if self.periodic and self.walls:
             raise GraphError(f"walls ({sorted(self.walls)}) in a periodic cell are not supported: a sphere meets a "

@@ -80,6 +80,15 @@ class Reader:
         Heat-only engines in a granular bed: run each call's numpy work on a worker thread
         while YADE steps on; results reach the bodies one call later (default False). Pays
         only when YADE leaves a core free.
+    clumps : {'lumped', 'resolved'}, optional
+        Granular beds: clumps of spheres (``O.bodies.appendClumped``) conduct, their members
+        being spheres. ``'lumped'`` (the default in a granular bed): one temperature per clump,
+        its members' capacities added, the conductances between members of two clumps added
+        per clump pair; ``'resolved'``: each member its own temperature, members of one clump
+        joined through the lens where they overlap (see
+        :mod:`yade_electro.network.lumping`). Currents flow member by member in both. The
+        temperature is written on the members and on the clump body. Bonded solids leave
+        clumps out (a warning).
     """
 
     bonds: str = "cohesive"
@@ -92,6 +101,7 @@ class Reader:
     skin: Any = "auto"
     reselect: bool = False
     overlap: bool = False
+    clumps: Optional[str] = None
 
     def __post_init__(self):
         if self.bonds not in ("cohesive", "contacts"):
@@ -100,12 +110,19 @@ class Reader:
         for name in ("reselect", "overlap"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"Reader {name} must be True or False, got {getattr(self, name)!r}")
+        if self.clumps not in (None, "lumped", "resolved"):
+            raise ValueError(f"Reader clumps must be 'lumped' (one temperature per clump) or 'resolved' (one per "
+                             f"member), got {self.clumps!r}")
+        if self.clumps is not None and self.bonds != "contacts":
+            raise ValueError("Reader clumps= is for granular beds (bonds='contacts'): a bonded solid's reader leaves "
+                             "clumps out")
 
     def scene_options(self) -> dict:
         """The scene reader's keyword arguments."""
         return dict(bonds=self.bonds, mask=self.mask, geometry_every=self.geometry_every,
                     move_tolerance=self.move_tolerance, full_read_every=self.full_read_every,
-                    bond_check=self.bond_check, sweep_calls=self.sweep_calls, skin=self.skin)
+                    bond_check=self.bond_check, sweep_calls=self.sweep_calls, skin=self.skin,
+                    clumps=self.clumps if self.clumps is not None or self.bonds != "contacts" else "lumped")
 
 
 @dataclass(frozen=True)

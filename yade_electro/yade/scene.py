@@ -94,6 +94,7 @@ class SphereBodies(NamedTuple):
     slot_of: "SlotMap"         # body id -> row of every existing body in YADE's bulk readers
     node_slot: np.ndarray      # (n,) row of each sphere in the bulk readers
     ignored: Counter           # what was left out, by reason
+    clump: Optional[np.ndarray] = None   # (n,) the clump body id of each sphere (-1: none); None: clumps left out
 
 
 #: why a periodic scene is refused (by the bonded reader, and for electrodes)
@@ -129,11 +130,16 @@ class SlotMap:
         return k if self._order is None else self._order[k]
 
 
-def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=None) -> SphereBodies:
-    """Every body whose shape is a ``Sphere`` (not a clump or clump member, and with ``b.mask &
-    mask`` when a mask is given), by a Python loop over ``O.bodies``. GraphError when there is
-    none, a radius is not finite and > 0, or the scene is periodic and the caller does not
-    take ``periodic`` cells (:data:`PERIODIC_REFUSAL`).
+def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=None,
+                 clumps: bool = False) -> SphereBodies:
+    """Every body whose shape is a ``Sphere`` (not a clump or clump member unless ``clumps``,
+    and with ``b.mask & mask`` when a mask is given), by a Python loop over ``O.bodies``.
+    GraphError when there is none, a radius is not finite and > 0, or the scene is periodic
+    and the caller does not take ``periodic`` cells (:data:`PERIODIC_REFUSAL`).
+
+    ``clumps``: clump members are spheres like the others, each with its clump's body id
+    (``SphereBodies.clump``); GraphError naming the clump when a member is not a sphere or
+    has no mass. The clump bodies themselves are not elements.
 
     ``keep``: a region, ``keep(ids, pos, radius) -> mask`` over every sphere; only the spheres
     it keeps are read (their YADE bodies fetched by id), so what is held grows with the
@@ -142,6 +148,7 @@ def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=Non
         raise GraphError(PERIODIC_REFUSAL)
     Sphere = import_yade().Sphere
     ids, xyz, rad, bodies, existing = array.array("q"), array.array("d"), array.array("d"), [], array.array("q")
+    clump_of = array.array("q")
     ignored = Counter()
     for b in O.bodies:
         if b is None:
@@ -150,12 +157,21 @@ def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=Non
         if mask is not None and not (b.mask & mask):
             ignored["masked out"] += 1
             continue
-        if b.isClump or b.isClumpMember:
-            ignored["clump"] += 1
+        if b.isClump or (b.isClumpMember and not clumps):
+            ignored["clump" if not clumps else "clump body"] += 1
             continue
         if not isinstance(b.shape, Sphere):
+            if b.isClumpMember:
+                raise GraphError(f"clump {b.clumpId}: its member {b.id} is a {type(b.shape).__name__}, not a sphere; "
+                                 "clumps conduct when they are made of spheres (O.bodies.appendClumped([sphere(...), "
+                                 "...])): build it of spheres, or leave it out with a mask")
             ignored[type(b.shape).__name__] += 1
             continue
+        if clumps:
+            if b.isClumpMember and not b.state.mass > 0:
+                raise GraphError(f"clump {b.clumpId}: its member {b.id} has no mass ({b.state.mass}); give its "
+                                 "material a density > 0")
+            clump_of.append(int(b.clumpId) if b.isClumpMember else -1)
         p = b.state.pos
         ids.append(b.id)
         xyz.extend((p[0], p[1], p[2]))
@@ -173,12 +189,14 @@ def read_spheres(O, mask: Optional[int] = None, periodic: bool = False, keep=Non
     if np.any(bad):
         raise GraphError(f"sphere radius must be finite and > 0; bodies {ids[bad][:10].tolist()} have "
                          f"{rad[bad][:5].tolist()}")
+    clump = np.frombuffer(clump_of, dtype=np.int64).copy() if clumps else None
     if keep is not None:
         chosen = np.asarray(keep(ids, pos, rad), dtype=bool)
         ids, pos, rad = ids[chosen], pos[chosen], rad[chosen]
+        clump = None if clump is None else clump[chosen]
         bodies = [O.bodies[i] for i in ids.tolist()]
     slot = SlotMap(np.frombuffer(existing, dtype=np.int64))
-    return SphereBodies(ids, pos, rad, bodies, slot, slot.rows(ids), ignored)
+    return SphereBodies(ids, pos, rad, bodies, slot, slot.rows(ids), ignored, clump)
 
 
 def warn_left_out(ignored: Counter, before: Counter) -> None:
@@ -187,8 +205,9 @@ def warn_left_out(ignored: Counter, before: Counter) -> None:
     elements), which a bed of clumps would otherwise get silently."""
     n = ignored.get("clump", 0)
     if n > before.get("clump", 0):
-        log.warning("%d clump(s) and clump member(s) are left out: clumps are not elements (only plain spheres "
-                    "are), so they carry no heat or current and their contacts do not conduct. Use spheres, or "
+        log.warning("%d clump(s) and clump member(s) are left out: a bonded solid's reader takes plain spheres "
+                    "only, so they carry no heat or current and their contacts do not conduct. Clumps conduct in a "
+                    "granular bed (Reader(bonds='contacts', clumps='lumped' or 'resolved')); here use spheres, or "
                     "leave the clumps out of the mask on purpose", n)
 
 
