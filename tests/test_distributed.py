@@ -146,6 +146,24 @@ def test_surface_electrodes_are_refused_with_yade_mpy_when_built(yade_exe, tmp_p
     assert out.count("run distributed under plain mpiexec only") == 2 and "['a']" in out, out
 
 
+CLUMP_SCRIPT = """
+from yade_electro.core.errors import BoundaryConditionError
+from yade_electro.yade import HeatEngine, Integrator, Material, Reader
+for k in range(6):
+    O.bodies.appendClumped([sphere((0, 0, 3.0 * k), 1.0), sphere((1.5, 0, 3.0 * k), 1.0)])
+try:
+    HeatEngine(material=Material(density=2600, specific_heat=800, conductivity=2.0), law="contact",
+               reader=Reader(bonds="contacts"), temperature=300.0, integrator=Integrator(dt=1.0, solver="petsc"))
+except BoundaryConditionError as exc:
+    print("REFUSED", exc, flush=True)
+"""
+
+
+def test_clumps_are_refused_in_a_distributed_run_when_built(yade_exe, tmp_path):
+    out = _refused_on_both_ranks(yade_exe, tmp_path, CLUMP_SCRIPT)
+    assert out.count("does not do clumps") == 2, out
+
+
 FAIL_SCRIPT = """
 import numpy as np
 from yade_electro.yade import ElectricalEngine, Electrode, Material, Reader

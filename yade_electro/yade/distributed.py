@@ -41,7 +41,7 @@ from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
 from .scene import ensure_thermal_state, write_body_attribute
 
-__all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls",
+__all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls", "refuse_clumps",
            "PETSC_SOLVERS", "Slabs", "slab_region", "chosen_ids"]
 
 #: the solver names of a distributed run, and the preconditioner each takes ('petsc-auto': the
@@ -75,6 +75,14 @@ def distributed_requested(solver) -> bool:
 def _refuse(what: str):
     raise BoundaryConditionError(f"a distributed run (solver='petsc' under mpiexec) does not do {what} yet; run it "
                                  "serially, or leave it out")
+
+
+def refuse_clumps(reader) -> None:
+    """BoundaryConditionError on every rank when some rank's reader found clump members (a
+    clump's members may sit on two ranks, and its heat is one): collective."""
+    if mpi_comm().allreduce(int(getattr(reader, "has_clumps", False))):
+        _refuse("clumps (their members may sit on two ranks, and a lumped clump's heat is one): run the bed "
+                "serially, or of spheres")
 
 
 def distributed_model(*, solver: str, resistivity, materials, law: str, law_params: Optional[dict],

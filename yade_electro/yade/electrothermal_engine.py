@@ -22,7 +22,7 @@ from .clumps import clump_volume_fraction, write_clump_temperatures
 from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
-from .distributed import DistributedCalls, chosen_ids, distributed_model
+from .distributed import DistributedCalls, chosen_ids, distributed_model, refuse_clumps
 from .electrical_engine import ElectricalEngine
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
 from .options import Output, Reader, thermal_settings
@@ -365,6 +365,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id:
             raise BoundaryConditionError("a distributed run (solver='petsc' under mpiexec) does not do steady states, "
                                          "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
+        refuse_clumps(self.reader)
         specs = self.model.specs if self.model is not None else ()
         ids = self._electrode_ids(graph)
         cond_ids = chosen_ids(graph, {
