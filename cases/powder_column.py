@@ -79,6 +79,9 @@ YOUNG = 200e9           # Pa
 POISSON = 0.3
 DENSITY = 7800.0        # kg/m^3
 RESISTIVITY = 1e-7      # ohm m
+#: a surface film's specific resistance [ohm m^2]: its resistance over a Hertz spot equals the
+#: spot's constriction rho_e / (2 a) at about 10 N (a = 32 um)
+FILM = 5e-12
 FORCES = tuple(np.logspace(0, 2, 7))   # N
 MODELS = ("hertz", "geometric")
 
@@ -96,6 +99,13 @@ def hertz_radius(F, r=RADIUS) -> np.ndarray:
 def chain_resistance(F, n, r=RADIUS) -> np.ndarray:
     """R [ohm] of n spheres in a row pressed by F: (n - 1) rho_e / (2 a)."""
     return (n - 1) * RESISTIVITY / (2.0 * hertz_radius(F, r))
+
+
+def chain_resistance_film(F, n, r=RADIUS, film=FILM) -> np.ndarray:
+    """R [ohm] of the chain with a film on every contact (Holm): (n - 1) (rho_e / (2 a) +
+    film / (pi a^2))."""
+    a = hertz_radius(F, r)
+    return (n - 1) * (RESISTIVITY / (2.0 * a) + film / (np.pi * a * a))
 
 
 def plate_radius(F, r=RADIUS) -> np.ndarray:
@@ -160,6 +170,14 @@ def run(n=10, forces=FORCES, progress=print):
         iterPeriod=10 ** 9,
         label=f"column_{m}")
                for m in MODELS}
+    engines["film"] = ElectricalEngine(
+        material=Material(resistivity=RESISTIVITY),
+        boundaries=[Electrode("top", select=[ids[-1]], potential=1.0), Electrode("bottom", select=[ids[0]], potential=0.0)],
+        law=Law("contact", radius="hertz", film=FILM),
+        reader=Reader(bonds="contacts", geometry_every=1, move_tolerance=1e-12),
+        output=Output(write_back=None),
+        iterPeriod=10 ** 9,
+        label="column_film")
     engines["plate"] = ElectricalEngine(
         material=Material(resistivity=RESISTIVITY),
         boundaries=[Electrode("top", select=[ids[-1]], potential=1.0), Electrode("plate", wall=plate, potential=0.0)],
@@ -172,7 +190,7 @@ def run(n=10, forces=FORCES, progress=print):
     for F in forces:
         fn, steps = press(O, ids, F)
         row = {"F": float(F), "steps": steps, "force_error": float(np.max(np.abs(fn / F - 1.0))),
-               "R_exact": float(chain_resistance(F, n))}
+               "R_exact": float(chain_resistance(F, n)), "R_film_exact": float(chain_resistance_film(F, n))}
         row["a_hertz"] = float(hertz_radius(F))
         row["R_plate_exact"] = float(plate_chain_resistance(F, n))
         # the overlap YADE's Mindlin law gives the sphere-plate contact under F, and the reduced
@@ -180,7 +198,7 @@ def run(n=10, forces=FORCES, progress=print):
         for m, e in engines.items():
             e.step()
             row[f"R_{m}"] = float(e.equivalent_resistance)
-            exact = row["R_plate_exact"] if m == "plate" else row["R_exact"]
+            exact = {"plate": row["R_plate_exact"], "film": row["R_film_exact"]}.get(m, row["R_exact"])
             row[f"R_error_pct_{m}"] = 100.0 * (row[f"R_{m}"] / exact - 1.0)
         nodes, dl = engines["plate"].reader.wall_contacts("plate")
         row["plate_overlap"] = float(dl[0])
@@ -192,11 +210,13 @@ def run(n=10, forces=FORCES, progress=print):
                  f"{row['R_geometric']:.5e} ({row['R_error_pct_geometric']:+.2f} %), exact {row['R_exact']:.5e}")
     logF = np.log([r["F"] for r in rows])
     out = {"case": "powder_column", "n": n, "contacts": n - 1, "forces_N": [r["F"] for r in rows]}
-    for m in MODELS + ("plate",):
+    for m in MODELS + ("plate", "film"):
         slope = float(np.polyfit(logF, np.log([r[f"R_{m}"] for r in rows]), 1)[0])
+        exact = -1.0 / 3.0 if m != "film" else float(np.polyfit(logF, np.log([r["R_film_exact"] for r in rows]), 1)[0])
         out[f"slope_{m}"] = slope
-        out[f"slope_error_pct_{m}"] = 100.0 * (slope / (-1.0 / 3.0) - 1.0)
+        out[f"slope_error_pct_{m}"] = 100.0 * (slope / exact - 1.0)
         out[f"max_R_error_pct_{m}"] = float(max(abs(r[f"R_error_pct_{m}"]) for r in rows))
+    out["slope_film_exact"] = float(np.polyfit(logF, np.log([r["R_film_exact"] for r in rows]), 1)[0])
     out["slope"], out["slope_error_pct"] = out["slope_hertz"], out["slope_error_pct_hertz"]
     out["max_R_error_pct"] = out["max_R_error_pct_hertz"]
     out["plate_r_star_over_r"] = float(np.mean([r["plate_r_star_over_r"] for r in rows]))
@@ -356,12 +376,19 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
     from yade_electro.yade import ElectricalEngine, Electrode, Law, Material, Output, Reader
     t0 = time.time()
     ids = build_random(n, seed, progress=progress)
-    engine = None
+    engine = film_engine = None
     rows, first = [], None
 
     def measure():
-        nonlocal engine
+        nonlocal engine, film_engine
         if engine is None:            # made once the bed carries the lid: its contacts exist
+            film_engine = ElectricalEngine(
+                material=Material(resistivity=RESISTIVITY),
+                boundaries=[Electrode("lid", wall=ids["lid"], potential=1.0),
+                            Electrode("plate", wall=ids["plate"], potential=0.0)],
+                law=Law("contact", radius="hertz", film=FILM),
+                reader=Reader(bonds="contacts", geometry_every=1, move_tolerance=1e-12),
+                output=Output(write_back=None), iterPeriod=10 ** 9, label="random_column_film")
             engine = ElectricalEngine(
                 material=Material(resistivity=RESISTIVITY),
                 boundaries=[
@@ -380,6 +407,10 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
             warnings.filterwarnings("ignore", message=".*connected to no electrode")
             steps, R, unbalanced = relax_random(O, ids, F, measure, progress=progress)
         plate_force = _wall_force(O, ids["plate"])
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message=".*connected to no electrode")
+            film_engine.step()
+        R_film = float(film_engine.equivalent_resistance)
         R_check, pairs = _network_from_forces(O, ids)
         if first is None:
             first = pairs
@@ -391,7 +422,7 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
         phi = sum(4.0 / 3.0 * np.pi * O.bodies[i].shape.radius ** 3 for i in ids["spheres"]) / (ids["width"] ** 2 * lid_z)
         row = {"F": float(F), "steps": int(steps), "plate_force_error": plate_force / F - 1.0,
                "unbalanced_force": unbalanced, "R": R, "R_check": R_check,
-               "R_check_error_pct": 100.0 * (R / R_check - 1.0), "R_fixed_contacts": R_fixed,
+               "R_check_error_pct": 100.0 * (R / R_check - 1.0), "R_fixed_contacts": R_fixed, "R_film": R_film,
                "contacts": len(pairs), "sphere_contacts": n_sph, "loaded_spheres": len(loaded),
                "coordination": 2.0 * n_sph / max(len(loaded), 1), "solid_fraction": phi, "height_m": lid_z,
                "floating_spheres": int(np.sum(engine.solution.floating))}
@@ -400,10 +431,12 @@ def run_random(n=RANDOM_N, forces=RANDOM_FORCES, seed=1, progress=print):
                  f"{row['R_check_error_pct']:+.2e} %), {len(pairs)} contacts, Z = {row['coordination']:.2f}, "
                  f"phi = {phi:.3f}, {steps} steps ({time.time() - t0:.0f} s)")
     engine.remove()
+    film_engine.remove()
     logF = np.log([r["F"] for r in rows])
     slope = float(np.polyfit(logF, np.log([r["R"] for r in rows]), 1)[0])
     slope_fixed = float(np.polyfit(logF, np.log([r["R_fixed_contacts"] for r in rows]), 1)[0])
-    return {"random_n": n, "random_seed": seed, "slope_random": slope,
+    slope_film = float(np.polyfit(logF, np.log([r["R_film"] for r in rows]), 1)[0])
+    return {"random_n": n, "random_seed": seed, "slope_random": slope, "slope_random_film": slope_film,
             "slope_random_vs_chain_pct": 100.0 * (slope / (-1.0 / 3.0) - 1.0), "slope_fixed_contacts": slope_fixed,
             "max_R_check_error_pct": float(max(abs(r["R_check_error_pct"]) for r in rows)),
             "random_s": round(time.time() - t0, 1), "rows": rows}

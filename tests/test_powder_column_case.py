@@ -57,3 +57,25 @@ def test_column_follows_the_hertz_chain(run_yade_script, tmp_path):
     # make the packing's slope steeper
     assert abs(row["slope_fixed_contacts"] + 1 / 3) < 0.03
     assert row["slope_random"] < row["slope_fixed_contacts"] < -0.3
+    # a surface film on every contact (Holm): the chain is exact with it too, its slope between the
+    # constriction's -1/3 and the film's -2/3; the random bed steeper with the film than without
+    assert row["max_R_error_pct_film"] < 1e-3 and abs(row["slope_error_pct_film"]) < 1e-3
+    assert -2 / 3 < row["slope_film_exact"] < -1 / 3
+    assert row["slope_random_film"] < row["slope_random"]
+
+
+def test_a_contact_film_is_in_series_with_the_constriction():
+    """Two spheres pressed together, a film of specific resistance s: R = rho / (2 a) + s / (pi a^2),
+    electrically; the thermal factor does not see it."""
+    from yade_electro.core.graph import ContactGraph
+    from yade_electro.laws.factors import conductance, make_law
+    r, delta, rho, s = 1e-3, 1e-6, 1e-7, 5e-12
+    g = ContactGraph(np.array([[0, 0, 0], [2 * r - delta, 0, 0]], float), np.array([r, r]), np.array([[0, 1]]))
+    a = math.sqrt(r / 2 * delta)
+    c = conductance(g, rho, "contact", radius="hertz", film=s)
+    assert 1 / c[0] == pytest.approx(rho / (2 * a) + s / (math.pi * a * a), rel=1e-12)
+    law = make_law("contact", radius="hertz", film=s)
+    assert law.factor(g)[0] == pytest.approx(2 * a, rel=1e-12)        # heat: the constriction only
+    assert law.wall_film_resistance([r], [delta])[0] == pytest.approx(s / (math.pi * r * delta), rel=1e-12)
+    with pytest.raises(ValueError, match="film must be finite and >= 0"):
+        make_law("contact", film=-1.0)

@@ -79,11 +79,15 @@ def edge_conductivity(lam, edges) -> np.ndarray:
     return 2.0 * a * b / (a + b)
 
 
-def electrical_conductance(factor, resistivity, edges) -> np.ndarray:
+def electrical_conductance(factor, resistivity, edges, series=None) -> np.ndarray:
     """Electrical conductance of each edge [S]: its geometric factor ``factor`` [m] over the
-    edge's resistivity [ohm m] (:func:`edge_resistivity`). The one place where a factor meets
-    a resistivity."""
-    return np.asarray(factor, dtype=float) / edge_resistivity(resistivity, edges)
+    edge's resistivity [ohm m] (:func:`edge_resistivity`), with ``series`` [ohm] per edge (a
+    contact film) in series when given. The one place where a factor meets a resistivity."""
+    c = np.asarray(factor, dtype=float) / edge_resistivity(resistivity, edges)
+    if series is None or np.ndim(series) == 0 and not series:
+        return c
+    with np.errstate(divide="ignore"):
+        return np.where(c > 0, 1.0 / (1.0 / np.where(c > 0, c, 1.0) + np.asarray(series, float)), 0.0)
 
 
 def thermal_conductance_of(factor, conductivity, edges) -> np.ndarray:

@@ -264,9 +264,16 @@ class GranularLaw(ConductanceLaw):
       (LIGGGHTS' exponent 1 for Hooke);
     * ``'lethe'``, k = 1/5: the radius correction Lethe uses (after Morris et al. 2016,
       which matches the heat of colliding, not resting, particles).
+
+    ``film`` [ohm m^2]: the specific electrical resistance of a surface film (an oxide, a
+    contamination layer) on every contact, sphere-sphere and sphere-wall, in series with the
+    constriction: a contact's resistance is ``rho_e / g + film / (pi a^2)`` (Holm: the
+    constriction of the contact spot plus the film across its area). Electrical only: heat
+    crosses the contact by the constriction (default 0: no film).
     """
 
-    def __init__(self, radius: str = "geometric", stiffness_ratio: float = 1.0, correction: str = "hertz"):
+    def __init__(self, radius: str = "geometric", stiffness_ratio: float = 1.0, correction: str = "hertz",
+                 film: float = 0.0):
         if radius not in CONTACT_RADII:
             raise ValueError(f"radius must be one of {CONTACT_RADII}, got {radius!r}")
         try:
@@ -281,6 +288,24 @@ class GranularLaw(ConductanceLaw):
             raise ValueError(f"correction must be one of {sorted(STIFFNESS_CORRECTIONS)}, got {correction!r}")
         self.radius, self.stiffness_ratio, self.correction = radius, s, correction
         self._scale = s ** STIFFNESS_CORRECTIONS[correction]
+        try:
+            film = float(film)
+        except (TypeError, ValueError):
+            raise ValueError(f"film must be a number >= 0 (ohm m^2, a film's specific resistance), got {film!r}") from None
+        if not (np.isfinite(film) and film >= 0):
+            raise ValueError(f"film must be finite and >= 0 (ohm m^2, a film's specific resistance), got {film!r}")
+        self.film = film
+
+    def film_resistance(self, graph, edges=None) -> np.ndarray:
+        """The film's resistance ``film / (pi a^2)`` [ohm] of each edge's contact (inf where
+        a = 0, 0 everywhere without a film)."""
+        a = self.contact_radius(graph, edges)
+        return _film(self.film, a)
+
+    def wall_film_resistance(self, radius, overlap) -> np.ndarray:
+        """The film's resistance [ohm] of spheres of ``radius`` pressed by ``overlap`` into a wall."""
+        from ..geometry.contacts import plane_contact_radius
+        return _film(self.film, self._scale * plane_contact_radius(radius, overlap, self.radius))
 
     #: g per unit contact radius [-]
     SHAPE = 2.0
@@ -296,6 +321,14 @@ class GranularLaw(ConductanceLaw):
         """g [m] of spheres of ``radius`` pressed by ``overlap`` into a wall (a plane)."""
         from ..geometry.contacts import plane_contact_radius
         return self.SHAPE * self._scale * plane_contact_radius(radius, overlap, self.radius)
+
+
+def _film(film: float, a) -> np.ndarray:
+    a = np.asarray(a, float)
+    if film == 0.0:
+        return np.zeros(a.shape)
+    with np.errstate(divide="ignore"):
+        return np.where(a > 0, film / (np.pi * a * a), np.inf)
 
 
 @register_conductance_law("contact")
@@ -335,8 +368,8 @@ class PipeLaw(GranularLaw):
     name = "pipe"
 
     def __init__(self, width: float = None, radius: str = "geometric", stiffness_ratio: float = 1.0,
-                 correction: str = "hertz"):
-        super().__init__(radius, stiffness_ratio, correction)
+                 correction: str = "hertz", film: float = 0.0):
+        super().__init__(radius, stiffness_ratio, correction, film)
         try:
             w = float(width)
         except (TypeError, ValueError):
@@ -465,7 +498,7 @@ def conductance(graph: ContactGraph, resistivity, law="continuum", **params) -> 
     law = make_law(law, **params)
     rho = positive_property("resistivity", resistivity, graph.n_nodes, " (ohm m for electrical resistivity)")
     g = law.factor(graph, graph.edges)
-    c = electrical_conductance(g, rho, graph.edges)
+    c = electrical_conductance(g, rho, graph.edges, series=getattr(law, "film", 0.0) and law.film_resistance(graph))
     if not np.all(np.isfinite(c)) or np.any(c < 0):
         raise MaterialError(f"conductance law {law.name!r} produced non-finite or negative values")
     return c

@@ -187,6 +187,7 @@ class ElectricalModel:
         self._graph_view = None
         self._surface_edges = np.zeros((0, 2), dtype=np.int64)
         self._surface_factor = np.zeros(0)
+        self._surface_series = np.zeros(0)      # a contact film's resistance [ohm] in series (walls)
         self.n_elements = None
 
     # -- values (owned here) -----------------------------------------------------------------
@@ -255,11 +256,16 @@ class ElectricalModel:
     def _full_conductance(self, n):
         """Conductances [S] of the problem's edges: the law's network (g / rho_edge), then the
         surface electrodes' half cells (g / rho of the element)."""
-        c = electrical_conductance(self.network.factor, self._resistivity_of(n), self.network.edges)
+        film = getattr(self.law, "film", 0.0)     # a contact film in series (granular laws)
+        c = electrical_conductance(self.network.factor, self._resistivity_of(n), self.network.edges,
+                                   series=film and self.law.film_resistance(self.network.graph, self.network.edges))
         if self._surface_edges.size:
             rho = np.asarray(self.resistivity, float)
             rho_i = rho if rho.ndim == 0 else rho[self._surface_edges[:, 0]]
-            c = np.concatenate([c, self._surface_factor / rho_i])
+            g = self._surface_factor
+            with np.errstate(divide="ignore"):
+                c = np.concatenate([c, np.where(g > 0, 1.0 / (rho_i / np.where(g > 0, g, 1.0) + self._surface_series),
+                                                0.0)])
         return c
 
     @property
@@ -296,13 +302,16 @@ class ElectricalModel:
             self._walls_stale = True
 
     def _wall_factor(self, name, graph, nodes):
-        """Factors g [m] of the kept edges ``nodes`` of wall ``name`` for its current contacts."""
+        """(factors g [m], film resistances [ohm]) of the kept edges ``nodes`` of wall ``name``
+        for its current contacts."""
         nd, dl = self._wall_contacts.contacts(name)
         over = np.zeros(nodes.size)
         if nd.size:
             pos = np.searchsorted(nodes, nd)
             over[pos] = dl
-        return self.law.wall_factor(graph.radius[nodes], over)
+        r = graph.radius[nodes]
+        film = self.law.wall_film_resistance(r, over) if getattr(self.law, "film", 0.0) else np.zeros(nodes.size)
+        return self.law.wall_factor(r, over), film
 
     def _walls_fit(self) -> bool:
         """True when every particle touching a wall electrode has an edge to it."""
@@ -319,7 +328,7 @@ class ElectricalModel:
 
     def _build(self, graph: ContactGraph):
         n = graph.n_nodes
-        electrodes, surf_edges, surf_g, surf_nodes = [], [], [], []
+        electrodes, surf_edges, surf_g, surf_film, surf_nodes = [], [], [], [], []
         for s in self.specs:
             if s.wall:
                 nd, _ = self._wall_contacts.contacts(s.name)
@@ -334,7 +343,9 @@ class ElectricalModel:
                 k = n + len(surf_nodes)
                 surf_nodes.append(k)
                 surf_edges.append(np.column_stack([nodes, np.full(nodes.size, k)]))
-                surf_g.append(self._wall_factor(s.name, graph, nodes))
+                g_w, film_w = self._wall_factor(s.name, graph, nodes)
+                surf_g.append(g_w)
+                surf_film.append(film_w)
                 electrodes.append(Electrode(s.name, [k], potential=s.potential, current=s.current))
             elif s.surface is not None:
                 contact = self._surface_contact(s, graph)
@@ -342,12 +353,14 @@ class ElectricalModel:
                 surf_nodes.append(k)
                 surf_edges.append(np.column_stack([contact.nodes, np.full(contact.nodes.size, k)]))
                 surf_g.append(contact.factor)
+                surf_film.append(np.zeros(contact.factor.size))
                 electrodes.append(Electrode(s.name, [k], potential=s.potential, current=s.current))
             else:
                 nodes = self.memberships[s.name].nodes(graph)
                 electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
         self._surface_edges = np.concatenate(surf_edges) if surf_edges else np.zeros((0, 2), dtype=np.int64)
         self._surface_factor = np.concatenate(surf_g) if surf_g else np.zeros(0)
+        self._surface_series = np.concatenate(surf_film) if surf_film else np.zeros(0)
         offsets = np.cumsum([0] + [len(g) for g in surf_g])
         self._wall_slices = {}
         names = [sp.name for sp in self.specs if sp.surface is not None or sp.wall]
@@ -386,7 +399,8 @@ class ElectricalModel:
             return "structure"
         if self.walls and self._walls_stale:
             for name, sl in self._wall_slices.items():
-                self._surface_factor[sl] = self._wall_factor(name, graph, self._wall_nodes[name])
+                self._surface_factor[sl], self._surface_series[sl] = self._wall_factor(name, graph,
+                                                                                         self._wall_nodes[name])
             self._walls_stale = False
             if kind is None:
                 kind = "geometry"

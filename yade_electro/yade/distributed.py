@@ -99,6 +99,8 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
     (adiabatic: conducts nothing), conductivity=)."""
     if materials is not None:
         _refuse("per-material tables (Materials): give one Material")
+    if float((law_params or {}).get("film", 0.0) or 0.0):
+        _refuse("contact films (Law(..., film=...)): leave the film out")
     comm = mpi_comm()
     if law not in DISTRIBUTED_LAWS:
         _refuse(f"the {law!r} law (it does {', '.join(DISTRIBUTED_LAWS)})")
