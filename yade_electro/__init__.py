@@ -26,7 +26,8 @@ The names below are the main objects; each subpackage lists its own in its ``__a
 """
 from .core import (BoundaryConditionError, ContactGraph, ElectroError, GraphError, History, Material,
                    MaterialError, SolverError, ThermalError)
-from .geometry import Box, Cylinder, Plane, Sphere, SurfaceContact, as_shape, boundary_areas, surface_contact
+from .geometry import (Box, Cylinder, MeshShape, Plane, Sphere, SurfaceContact, as_shape, boundary_areas,
+                       surface_contact)
 from .laws import (conductance_laws, eccentricity, edge_transmission_surface, geometric_factor, make_law,
                    polyhedron_alpha, polyhedron_volume_fraction, register_conductance_law, transmission_surface,
                    volume_fraction)
@@ -46,7 +47,7 @@ __all__ = [
     # data
     "ContactGraph", "Material", "History",
     # geometry
-    "Box", "Cylinder", "Sphere", "Plane", "as_shape", "boundary_areas", "surface_contact", "SurfaceContact",
+    "Box", "Cylinder", "MeshShape", "Sphere", "Plane", "as_shape", "boundary_areas", "surface_contact", "SurfaceContact",
     # conductance laws
     "conductance_laws", "register_conductance_law", "make_law", "geometric_factor", "transmission_surface",
     "edge_transmission_surface", "volume_fraction", "eccentricity", "polyhedron_alpha",

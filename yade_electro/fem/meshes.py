@@ -36,7 +36,7 @@ from skfem import MeshTet
 
 from ..core.errors import ElectroError
 
-__all__ = ["box_mesh", "rod_mesh", "coax_mesh", "plate_mesh", "notched_bar_mesh",
+__all__ = ["surface_triangles", "box_mesh", "rod_mesh", "coax_mesh", "plate_mesh", "notched_bar_mesh",
            "PlateGeometry", "NotchedBarGeometry", "MeshError", "mesh_size"]
 
 logger = logging.getLogger(__name__)
@@ -594,3 +594,19 @@ def cracked_bar_mesh(geometry: CrackedBarGeometry = CrackedBarGeometry(), h: flo
     t[:, above] = sub
     mesh = _to_skfem(p, t)
     return mesh.with_boundaries({"end0": lambda x: np.abs(x[2]) < tol, "end1": lambda x: np.abs(x[2] - L) < tol})
+
+
+def surface_triangles(path) -> tuple:
+    """(vertices (n, 3), triangles (m, 3)) of the surface triangles of a gmsh mesh file."""
+    with _GmshSession() as gmsh:
+        gmsh.open(str(path))
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        types, _, nodes = gmsh.model.mesh.getElements(2)
+        tri = [np.asarray(n, np.int64).reshape(-1, 3) for t, n in zip(types, nodes) if t == 2]
+    if not tri:
+        raise MeshError(f"{str(path)!r} holds no surface triangles (gmsh element type 2)")
+    index = np.full(int(np.max(tags)) + 1, -1, np.int64)
+    index[np.asarray(tags, np.int64)] = np.arange(len(tags))
+    t = index[np.concatenate(tri)]
+    used, t = np.unique(t, return_inverse=True)
+    return np.asarray(coords, float).reshape(-1, 3)[used], t.reshape(-1, 3)

@@ -14,6 +14,7 @@ from .contacts import (sphere_tree, candidate_pairs, periodic_candidate_pairs, c
 from .ghosts import ghost_points, tessellate_with_ghosts, progress_lines
 from .shapes import (Shape, Cylinder, Box, Sphere, Difference, Intersection, Union, GridShape, as_shape,
                      container_volume, as_surface)
+from .surface_mesh import MeshShape, read_stl
 from .surfaces import SurfaceSelector, Plane, OnSurface
 from .tessellation import Tessellation, tessellate, circumcentres
 from .voronoi import voronoi_faces, VoronoiFaces, voronoi_cell_volumes, cell_volume_of
@@ -27,7 +28,7 @@ __all__ = ["SurfaceContact", "surface_contact", "half_cell_length", "SavedSurfac
            "sphere_tree", "candidate_pairs", "periodic_candidate_pairs", "cell_widths", "new_wall_contacts",
            "max_displacement", "WallGeometry", "wall_candidates", "wall_overlaps", "plane_contact_radius",
            "triangle_distance", "quaternion_matrices", "facet_vertices", "ghost_points",
-           "tessellate_with_ghosts", "progress_lines", "Shape", "Cylinder", "Box", "Sphere", "Difference",
+           "tessellate_with_ghosts", "progress_lines", "MeshShape", "read_stl", "Shape", "Cylinder", "Box", "Sphere", "Difference",
            "Intersection", "Union", "GridShape", "as_shape", "container_volume", "as_surface",
            "SurfaceSelector", "Plane", "OnSurface", "Tessellation", "tessellate", "circumcentres",
            "voronoi_faces", "VoronoiFaces", "voronoi_cell_volumes", "cell_volume_of"]
