@@ -74,22 +74,12 @@ def lumped(g, t):
 
 def grain(g, n: int, cache_dir=None):
     """(centres, radii, edges, factors g [m], cell volumes [m^3]) of grain A: a dense packing of
-    the disc segment with the 'voronoi' law."""
-    from scipy.spatial import cKDTree
-    from yade_electro.core.graph import ContactGraph
+    the disc segment with the 'voronoi' law (:func:`~yade_electro.packing.grains.grain_template`)."""
     from yade_electro.geometry.shapes import Box, Cylinder, Intersection
-    from yade_electro.laws.factors import make_law
-    from yade_electro.packing import dense_packing
+    from yade_electro.packing.grains import grain_template
     shape = Intersection(Cylinder((0, 0, 0), (0, 0, g.w), g.r), Box((-2 * g.r, -2 * g.r, -g.w), (0.5 * g.d, 2 * g.r, 2 * g.w)))
-    pk = dense_packing(shape, n=n, seed=1, cache_dir=cache_dir)
-    c, r = pk.centers, pk.radii
-    pairs = cKDTree(c).query_pairs(2.2 * float(r.max()), output_type="ndarray")
-    dist = np.linalg.norm(c[pairs[:, 0]] - c[pairs[:, 1]], axis=1)
-    bonds = pairs[dist < 1.1 * (r[pairs[:, 0]] + r[pairs[:, 1]])]
-    graph = ContactGraph(c, r, bonds)
-    law = make_law("voronoi", container=shape)
-    edges = law.network(graph)
-    return c, r, edges, law.factor(graph, edges), law.cell_volumes(graph)
+    t = grain_template(shape, n, seed=1, cache_dir=cache_dir)
+    return t.centres, t.radii, t.edges, t.factor, t.volume
 
 
 def resolved(g, k: float, t, n: int, cache_dir=None) -> dict:
