@@ -89,14 +89,14 @@ with warnings.catch_warnings():
 d_phi = max(comm.allgather(float(np.max(np.abs(phi[:share.n_owned] - sol3.potential[own]), initial=0.0))))
 out["changed"] = {"max_dphi_V": d_phi, "iterations": pcnd.info["iterations"], "setups": pcnd.info["setups"]}
 
-# -- 'auto': the first solves try deflation, then GAMG (2 each), the faster is kept; every
+# -- 'auto': the first solves try deflation, GAMG, BoomerAMG (2 each), the fastest is kept; every
 # solve, trial or not, must be the serial answer -------------------------------------------
 worst, picked = 0.0, []
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     pcnd = PartitionedConduction(share, c[held], el, ["a", "b"], {"a": 1.0, "b": 0.0}, comm=comm,
                                  preconditioner="auto", rtol=1e-12, pos=g.pos[own], spacing=2e-4)
-    for k in range(6):
+    for k in range(8):
         ck = c * (1.0 + 0.01 * k)
         ck[::7] *= 1.0 + 0.05 * k                      # the values drift, the pattern holds
         ref = ConductionProblem(n, edges, ck, [Electrode("a", bottom, potential=1.0),
@@ -202,7 +202,7 @@ for theta in (0.0, 0.5, 1.0):
         "max_dT_K": dT, "heat_rel_diff": abs(par.link_energy["wall"] - ser.link_energy["wall"]) /
         abs(ser.link_energy["wall"]), "flow_rel_diff": abs(par.link_flows()["wall"] - ser.link_flows()["wall"]) /
         abs(ser.link_flows()["wall"])}
-# the heat step with 'auto': backward Euler, 6 steps (deflation, deflation, GAMG, GAMG, choice)
+# the heat step with 'auto': backward Euler, 8 steps (deflation, GAMG, BoomerAMG twice each, the choice)
 ser = HeatSolver(C, edges, G, T0, theta=1.0, solver="direct",
                  conditions=[FixedTemperature("cold", nodes=bottom, temperature=290.0),
                              Convection("side", nodes=side, h=1.0, t_inf=280.0, area=3e-3)])
@@ -211,7 +211,7 @@ fixed[bottom] = 290.0
 par = PartitionedHeat(share, C[own], G[held], T0[own], fixed=fixed[own], h_area=hA[own],
                       t_inf=np.full(own.shape[0], 280.0), theta=1.0, comm=comm, rtol=1e-13,
                       pos=g.pos[own], spacing=2e-4, preconditioner="auto")
-for _ in range(6):
+for _ in range(8):
     ser.advance(0.05, sources=Pw)
     par.advance(0.05, power=Pw[own])
 out["heat_auto"] = {"max_dT_K": max(comm.allgather(float(np.max(np.abs(par.T - ser.temperature[own]), initial=0.0)))),

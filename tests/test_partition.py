@@ -94,11 +94,12 @@ def test_partitioned_solves_match_the_serial_ones(ranks):
         assert abs(r["I_sum"]) < 1e-10 and r["max_dP_rel"] < 1e-9, (pc, r)
         assert r["floating_ok"] and r["floating_warned"] == out["serial_floating_warned"], (pc, r)
     assert out["changed"]["max_dphi_V"] < 1e-9, out["changed"]
-    auto = out["auto"]                 # deflation twice, GAMG twice, then the faster of the two
-    assert auto["max_dphi_V"] < 1e-9 and auto["chosen"] in ("deflation", "gamg"), auto
-    assert auto["preconditioners"][:4] == ["deflation", "deflation", "gamg", "gamg"], auto
-    assert auto["preconditioners"][4:] == [auto["chosen"]] * 2, auto
-    assert out["heat_auto"]["max_dT_K"] < 1e-9 and out["heat_auto"]["chosen"] in ("deflation", "gamg"), out["heat_auto"]
+    auto = out["auto"]                 # deflation, GAMG, BoomerAMG twice each, then the fastest
+    assert auto["max_dphi_V"] < 1e-9 and auto["chosen"] in ("deflation", "gamg", "hypre"), auto
+    assert auto["preconditioners"][:6] == ["deflation", "deflation", "gamg", "gamg", "hypre", "hypre"], auto
+    assert auto["preconditioners"][6:] == [auto["chosen"]] * 2, auto
+    assert out["heat_auto"]["max_dT_K"] < 1e-9, out["heat_auto"]
+    assert out["heat_auto"]["chosen"] in ("deflation", "gamg", "hypre"), out["heat_auto"]
     for theta in ("0", "0.5", "1"):
         h = out[f"heat_theta_{theta}"]
         assert h["max_dT_K"] < 1e-9 and h["content_rel_diff"] < 1e-10, (theta, h)

@@ -1,10 +1,10 @@
 """``preconditioner='auto'`` of a partitioned solve: the run's own solves measure the candidates
 and the fastest is kept.
 
-Which preconditioner is fastest for a re-solve depends on the system, the size and the ranks:
-on this project's benches (``bench/bench_peers.py``, partitioned lines) our deflation is ahead
-of GAMG on one rank and at most sizes, GAMG's kept hierarchy 4-20 % ahead in some 2-3 rank
-rows. :class:`MeasuredChoice` therefore tries each candidate on the solves the run makes anyway:
+Which preconditioner is fastest depends on the system, the size and the ranks: on this
+project's benches (``bench/bench_peers.py``, partitioned lines) our deflation is ahead on one
+rank and at most sizes, GAMG's kept hierarchy 4-20 % ahead of it re-solving in some 2-3 rank
+rows, and BoomerAMG the fastest of all on the 1M-unknown Voronoi rod on 2 ranks. :class:`MeasuredChoice` therefore tries each candidate on the solves the run makes anyway:
 ``trial_solves`` solves each (the first builds the candidate's setup; the last is a re-solve on
 the kept setup, the cost every later call pays), timed from the values' update to the end of the
 solve on the slowest rank (a collective maximum, so every rank picks the same). It then keeps
@@ -20,12 +20,21 @@ import logging
 import time
 from typing import Callable, Optional, Sequence
 
-__all__ = ["MeasuredChoice", "AUTO_CANDIDATES"]
+__all__ = ["MeasuredChoice", "AUTO_CANDIDATES", "auto_candidates"]
 
 log = logging.getLogger(__name__)
 
-#: what ``'auto'`` tries, in this order (the default first)
-AUTO_CANDIDATES = ("deflation", "gamg")
+#: what ``'auto'`` tries, in this order (the default first), BoomerAMG when PETSc has hypre
+#: (:func:`auto_candidates`): on the 1M-unknown Voronoi rod on 2 ranks it is the fastest of all
+AUTO_CANDIDATES = ("deflation", "gamg", "hypre")
+
+
+def auto_candidates() -> tuple:
+    """:data:`AUTO_CANDIDATES` less 'hypre' when PETSc is built without it."""
+    from .petsc import import_petsc
+    if import_petsc().Sys.hasExternalPackage("hypre"):
+        return AUTO_CANDIDATES
+    return tuple(c for c in AUTO_CANDIDATES if c != "hypre")
 
 
 class MeasuredChoice:
@@ -37,15 +46,16 @@ class MeasuredChoice:
         ``make(name)`` -> a :class:`~yade_electro.solvers.partitioned.PartitionedSystem` with
         preconditioner ``name`` (collective).
     comm : mpi4py communicator
-    candidates : names tried, in order
+    candidates : names tried, in order (default :func:`auto_candidates`)
     trial_solves : int >= 2
         Solves per candidate (the first builds its setup).
     """
 
-    def __init__(self, make: Callable[[str], object], comm, candidates: Sequence[str] = AUTO_CANDIDATES,
+    def __init__(self, make: Callable[[str], object], comm, candidates: Optional[Sequence[str]] = None,
                  trial_solves: int = 2):
         if int(trial_solves) < 2:
             raise ValueError(f"trial_solves must be >= 2 (a cold solve, then a re-solve), got {trial_solves}")
+        candidates = auto_candidates() if candidates is None else candidates
         if not candidates:
             raise ValueError("give at least one candidate preconditioner")
         self._make, self.comm = make, comm
