@@ -79,15 +79,16 @@ def pour(nuts: int, shape: str, seed: int = 1):
     bottom = O.bodies.append(geom.facetCylinder((0, 0, 0.5 * height), CONTAINER_R, height, wallMask=2,
                                                 segmentsNumber=36, material="steel"))
     half = 0.68 * CONTAINER_R
+    # a cloud tall enough for the particles' bounding spheres (makeClumpCloud places them apart)
+    top = 0.01 + max(3 * height, 1.5 * nuts * (2.4 * (RING_R + MEMBER_R)) ** 3 / (2 * half) ** 2)
     sp = pack.SpherePack()
     if shape == "nut":
         c, r = nut_template()
         tmpl = pack.SpherePack([(tuple(p), float(q)) for p, q in zip(c, r)])
-        made = sp.makeClumpCloud((-half, -half, 0.01), (half, half, 3 * height), [tmpl], num=nuts, seed=seed)
+        made = sp.makeClumpCloud((-half, -half, 0.01), (half, half, top), [tmpl], num=nuts, seed=seed)
     else:
         r_eq = (3 * nut_volume() / (4 * np.pi)) ** (1 / 3)
-        made = sp.makeCloud((-half, -half, r_eq), (half, half, 3 * height), rMean=r_eq, rRelFuzz=0.0, num=nuts,
-                            seed=seed)
+        made = sp.makeCloud((-half, -half, r_eq), (half, half, top), rMean=r_eq, rRelFuzz=0.0, num=nuts, seed=seed)
     if made < nuts:
         raise RuntimeError(f"only {made} of {nuts} {shape}s fit in the pouring region")
     sp.toSimulation(material="steel")

@@ -296,14 +296,20 @@ e = HeatEngine(
     temperature=300.0,
     reader=Reader(bonds="contacts"),
     label="heat")
-print(json.dumps({"nodes": int(e.reader.graph.n_nodes), "clumps": e.reader.ignored["clump"]}))
+from yade_electro.yade.scene import SceneReader
+bonded = SceneReader(O)
+bonded.read()
+print(json.dumps({"nodes": int(e.reader.graph.n_nodes), "clump_bodies": e.reader.ignored["clump body"],
+                  "bonded_nodes": int(bonded.graph.n_nodes), "bonded_left_out": bonded.ignored["clump"]}))
 """
 
 
-def test_clumps_left_out_are_said(run_yade_script, tmp_path):
+def test_clumps_conduct_in_a_bed_and_are_left_out_of_a_bonded_solid(run_yade_script, tmp_path):
+    """A granular bed takes clump members as elements (lumped by default); a bonded solid's
+    reader leaves clumps out, and says so."""
     res = run_yade_script(CLUMPS, timeout=120, cwd=tmp_path, check=True)
-    assert res.result == {"nodes": 2, "clumps": 3}          # the clump body and its two members
-    assert "3 clump(s) and clump member(s) are left out" in res.stderr
+    assert res.result == {"nodes": 4, "clump_bodies": 1, "bonded_nodes": 2, "bonded_left_out": 3}
+    assert "3 clump(s) and clump member(s) are left out" in res.stderr and "clumps='lumped'" in res.stderr
 
 
 def test_drum_case_small(run_yade_script, tmp_path):
