@@ -217,7 +217,8 @@ class DistributedElectroThermal:
         """The elements (body ids; those this rank does not own are ignored) of the surface
         condition ``name``, kept for the run, with per element: an electrode's or a fixed
         temperature's half-cell factor g [m] (a half cell conducts ``g / rho_e`` or
-        ``lambda g``), a convection's area [m^2] (its faces in series with the half cell)."""
+        ``lambda g``), a convection's area [m^2] (its faces in series with the half cell), a
+        heat flux's faces' area [m^2]."""
         if name not in self.surface_names:
             raise BoundaryConditionError(f"no surface condition named {name!r}; have {sorted(self.surface_names)}")
         ids, v = np.asarray(ids, np.int64).ravel(), np.asarray(values, float).ravel()
