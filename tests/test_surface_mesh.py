@@ -114,7 +114,7 @@ def test_a_gmsh_surface_mesh_makes_a_shape(tmp_path):
     """A sphere meshed by gmsh (surface triangles, written as .msh), read back: a closed surface
     whose solid is the sphere to the mesh's resolution."""
     gmsh = pytest.importorskip("gmsh")
-    from yade_electro.fem.meshes import surface_triangles
+    from yade_electro.fem.gmsh_session import surface_triangles
     path = tmp_path / "ball.msh"
     gmsh.initialize(readConfigFiles=False)
     try:

@@ -34,16 +34,13 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import MeshTet
 
-from ..core.errors import ElectroError
+from .gmsh_session import GmshSession as _GmshSession
+from .gmsh_session import MeshError
 
-__all__ = ["surface_triangles", "box_mesh", "rod_mesh", "coax_mesh", "plate_mesh", "notched_bar_mesh",
+__all__ = ["box_mesh", "rod_mesh", "coax_mesh", "plate_mesh", "notched_bar_mesh",
            "PlateGeometry", "NotchedBarGeometry", "MeshError", "mesh_size"]
 
 logger = logging.getLogger(__name__)
-
-
-class MeshError(ElectroError, ValueError):
-    """A geometry or mesh request is invalid (bad dimensions, h too large, gmsh missing)."""
 
 
 def _positive(**values):
@@ -104,31 +101,6 @@ def box_mesh(lx: float, ly: float, lz: float, h: float | tuple = None, *, n=None
 
 
 # --------------------------------------------------------------------------- gmsh plumbing
-def _gmsh():
-    try:
-        import gmsh  # noqa: WPS433 (imported lazily: optional dependency)
-    except ImportError as exc:  # pragma: no cover - depends on the machine
-        raise MeshError("gmsh's Python API is needed for this geometry: "
-                        "apt-get install python3-gmsh gmsh (Debian 12)") from exc
-    return gmsh
-
-
-class _GmshSession:
-    """Context manager: an initialised, silent gmsh with one empty model; finalised on exit."""
-
-    def __enter__(self):
-        self.gmsh = _gmsh()
-        self.gmsh.initialize(readConfigFiles=False)
-        self.gmsh.option.setNumber("General.Terminal", 0)
-        self.gmsh.option.setNumber("General.Verbosity", 1)
-        self.gmsh.model.add("yade_electro")
-        return self.gmsh
-
-    def __exit__(self, *exc):
-        self.gmsh.finalize()
-        return False
-
-
 def _background_field(gmsh, field):
     """Make ``field`` the mesh size everywhere (points and boundaries do not override it)."""
     gmsh.model.mesh.field.setAsBackgroundMesh(field)
@@ -594,19 +566,3 @@ def cracked_bar_mesh(geometry: CrackedBarGeometry = CrackedBarGeometry(), h: flo
     t[:, above] = sub
     mesh = _to_skfem(p, t)
     return mesh.with_boundaries({"end0": lambda x: np.abs(x[2]) < tol, "end1": lambda x: np.abs(x[2] - L) < tol})
-
-
-def surface_triangles(path) -> tuple:
-    """(vertices (n, 3), triangles (m, 3)) of the surface triangles of a gmsh mesh file."""
-    with _GmshSession() as gmsh:
-        gmsh.open(str(path))
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        types, _, nodes = gmsh.model.mesh.getElements(2)
-        tri = [np.asarray(n, np.int64).reshape(-1, 3) for t, n in zip(types, nodes) if t == 2]
-    if not tri:
-        raise MeshError(f"{str(path)!r} holds no surface triangles (gmsh element type 2)")
-    index = np.full(int(np.max(tags)) + 1, -1, np.int64)
-    index[np.asarray(tags, np.int64)] = np.arange(len(tags))
-    t = index[np.concatenate(tri)]
-    used, t = np.unique(t, return_inverse=True)
-    return np.asarray(coords, float).reshape(-1, 3)[used], t.reshape(-1, 3)

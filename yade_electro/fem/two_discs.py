@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from .meshes import MeshError, _GmshSession
+from .gmsh_session import GmshSession, MeshError
 
 __all__ = ["TwoDiscs", "disc_segment_mesh", "two_discs_transient"]
 
@@ -66,7 +66,7 @@ class TwoDiscs:
 def disc_segment_mesh(g: TwoDiscs, h: float):
     """(points (2, n), triangles (3, m), chord nodes) of disc A: centred at the origin, cut at
     x = d / 2, mesh size ``h`` [m] (finer, h / 4, along the chord)."""
-    with _GmshSession() as gmsh:
+    with GmshSession() as gmsh:
         occ = gmsh.model.occ
         disc = occ.addDisk(0.0, 0.0, 0.0, g.r, g.r)
         cut = occ.addRectangle(-2.0 * g.r, -2.0 * g.r, 0.0, 2.0 * g.r + 0.5 * g.d, 4.0 * g.r)

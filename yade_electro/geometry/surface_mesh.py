@@ -12,7 +12,7 @@ voxels of the surface the grid holds the exact distance to the triangles (farthe
 transforms'), interpolated trilinearly (default voxel: 1/64 of the largest side).
 
 :func:`read_stl` reads ASCII and binary STL; a gmsh mesh's surface triangles come from
-:func:`yade_electro.fem.meshes.surface_triangles` (``MeshShape(*surface_triangles(path))``).
+:func:`yade_electro.fem.gmsh_session.surface_triangles` (``MeshShape(*surface_triangles(path))``).
 
 Units: m.
 """
