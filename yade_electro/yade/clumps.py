@@ -24,6 +24,7 @@ def clump_volume_fraction(reader):
             return np.ones(graph.n_nodes)
         sphere = 4.0 / 3.0 * np.pi * np.asarray(graph.radius, float) ** 3
         return sphere / member_volumes(graph.pos, graph.radius, labels)
+    fraction.without_clumps = 1.0     # what it is on spheres alone (a distributed run, which refuses clumps)
     return fraction
 
 

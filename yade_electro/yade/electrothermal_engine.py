@@ -372,7 +372,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
             name: m for name, m in c.bc_memberships.items()
             if any(b.name == name and getattr(b, "surface", None) is None for b in self._heat_conditions)},
             what="thermal boundary condition")
-        vf = c.volume_fraction if not callable(c.volume_fraction) else None
+        vf = c.volume_fraction if not callable(c.volume_fraction) else getattr(c.volume_fraction, "without_clumps", None)
         heat = dict(density=t["density"], specific_heat=t["specific_heat"], conductivity=t["conductivity"],
                     temperature=t["temperature"], beta=t["beta"], eta=t["eta"], theta=t["theta"],
                     reference_temperature=t["coupled_options"].get("reference_temperature"), volume_fraction=vf,
