@@ -25,7 +25,7 @@ import numpy as np
 
 from .errors import MaterialError
 
-__all__ = ["Material", "positive_property", "real_number", "edge_resistivity", "edge_conductivity",
+__all__ = ["Material", "positive_property", "real_number", "edge_resistivity", "edge_conductivity", "in_series",
            "electrical_conductance", "thermal_conductance_of"]
 
 
@@ -83,7 +83,13 @@ def electrical_conductance(factor, resistivity, edges, series=None) -> np.ndarra
     """Electrical conductance of each edge [S]: its geometric factor ``factor`` [m] over the
     edge's resistivity [ohm m] (:func:`edge_resistivity`), with ``series`` [ohm] per edge (a
     contact film) in series when given. The one place where a factor meets a resistivity."""
-    c = np.asarray(factor, dtype=float) / edge_resistivity(resistivity, edges)
+    return in_series(np.asarray(factor, dtype=float) / edge_resistivity(resistivity, edges), series)
+
+
+def in_series(conductance, series=None) -> np.ndarray:
+    """Conductances [S] with resistances ``series`` [ohm] (per edge, or a scalar) in series:
+    ``1 / (1/c + R)`` where c > 0, 0 elsewhere; unchanged when ``series`` is None or 0."""
+    c = np.asarray(conductance, dtype=float)
     if series is None or np.ndim(series) == 0 and not series:
         return c
     with np.errstate(divide="ignore"):

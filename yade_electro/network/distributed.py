@@ -487,8 +487,7 @@ class PartitionedHeat:
     def _step(self, T0, h, P):
         """One (sub-)step of ``h`` [s]: (T at its end, T at its theta point)."""
         s, th = self._share, self.theta
-        ambient = self.h_area * self.t_inf + self.link_value @ self.link_G if self.link_names \
-            else self.h_area * self.t_inf
+        ambient = self.h_area * self.t_inf + self.link_value @ self.link_G     # (0, n) links: zeros
         rhs = self._free(ambient + P - self.flow(T0))
         Cdt = self.capacity / h
         if th == 0.0:

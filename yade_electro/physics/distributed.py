@@ -61,6 +61,25 @@ DISTRIBUTED_LAWS = ("continuum", "contact", "liggghts", "pipe", "voronoi")
 REGION_LAWS = ("voronoi",)
 
 
+def _per_element(ids, values, message: str):
+    """(ids, values) as flat arrays, one finite value >= 0 per body id; else
+    BoundaryConditionError(``message``)."""
+    ids, v = np.asarray(ids, np.int64).ravel(), np.asarray(values, float).ravel()
+    if ids.shape != v.shape or not np.all(np.isfinite(v)) or np.any(v < 0):
+        raise BoundaryConditionError(message)
+    return ids, v
+
+
+def _owned(by_id, share: Share):
+    """(owned node indices, their values) of ``by_id`` = (body ids, values) (None: none): the
+    entries of the ids this rank owns in ``share``."""
+    if by_id is None or not share.n_owned or not by_id[0].size:
+        return np.zeros(0, np.int64), np.zeros(0)
+    ids, v = by_id
+    on = np.isin(ids, share.owned_ids)
+    return share.graph.index_of(ids[on]), v[on]
+
+
 @dataclass(frozen=True)
 class Held:
     """Elements held at a value: an electrode at ``value`` V or a fixed temperature at ``value``
@@ -221,18 +240,13 @@ class DistributedElectroThermal:
         heat flux's faces' area [m^2]."""
         if name not in self.surface_names:
             raise BoundaryConditionError(f"no surface condition named {name!r}; have {sorted(self.surface_names)}")
-        ids, v = np.asarray(ids, np.int64).ravel(), np.asarray(values, float).ravel()
-        if ids.shape != v.shape or not np.all(np.isfinite(v)) or np.any(v < 0):
-            raise BoundaryConditionError(f"{name!r}: values must be finite and >= 0, one per element")
-        self._surfaces[name] = (ids, v)
+        self._surfaces[name] = _per_element(ids, values, f"{name!r}: values must be finite and >= 0, one per element")
 
     def _surface_values(self, name: str, share: Share) -> np.ndarray:
         """The values :meth:`set_surface` gave on each owned node (0 elsewhere)."""
         g = np.zeros(share.n_owned)
-        ids, v = self._surfaces.get(name, (np.zeros(0, np.int64), np.zeros(0)))
-        if share.n_owned and ids.size:
-            on = np.isin(ids, share.owned_ids)
-            g[share.graph.index_of(ids[on])] = v[on]
+        nodes, v = _owned(self._surfaces.get(name), share)
+        g[nodes] = v
         return g
 
     @property
@@ -246,23 +260,18 @@ class DistributedElectroThermal:
         ``name`` now and their overlaps [m] (> 0), for the next call."""
         if name not in self.wall_names:
             raise BoundaryConditionError(f"no wall named {name!r}; have {self.wall_names}")
-        ids, dl = np.asarray(ids, np.int64).ravel(), np.asarray(overlap, float).ravel()
-        if ids.shape != dl.shape or not np.all(np.isfinite(dl)) or np.any(dl < 0):
-            raise BoundaryConditionError(f"wall {name!r}: overlaps must be finite and >= 0 (m), one per sphere")
-        self._contacts[name] = (ids, dl)
+        self._contacts[name] = _per_element(ids, overlap,
+                                            f"wall {name!r}: overlaps must be finite and >= 0 (m), one per sphere")
 
     def _wall_factor(self, name: str, share: Share) -> np.ndarray:
         """Geometric factor g [m] of each owned node's link to wall or surface ``name`` (0:
         none): a wall's contact, a surface's half cell."""
-        n = share.n_owned
         if name in self.surface_names:
             return self._surface_values(name, share)
-        g = np.zeros(n)
-        ids, dl = self._contacts.get(name, (np.zeros(0, np.int64), np.zeros(0)))
-        if n and ids.size:
-            on = np.isin(ids, share.owned_ids)
-            nodes = share.graph.index_of(ids[on])
-            g[nodes] = self.law.wall_factor(share.graph.radius[nodes], dl[on])
+        g = np.zeros(share.n_owned)
+        nodes, dl = _owned(self._contacts.get(name), share)
+        if nodes.size:
+            g[nodes] = self.law.wall_factor(share.graph.radius[nodes], dl)
         return g
 
     def _electrode_links(self, share: Share, T_owned) -> Optional[np.ndarray]:

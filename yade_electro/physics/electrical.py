@@ -31,7 +31,7 @@ from ..laws.factors import ConductanceLaw, FactorNetwork
 from ..laws.law import Law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
-from ..core.materials import Material, electrical_conductance, positive_property
+from ..core.materials import Material, electrical_conductance, in_series, positive_property
 from ..network.conduction import ConductionProblem
 from ..network.records import PotentialSolution
 from ..network.kirchhoff import Electrode, PotentialOrCurrent, electrode_value
@@ -262,10 +262,7 @@ class ElectricalModel:
         if self._surface_edges.size:
             rho = np.asarray(self.resistivity, float)
             rho_i = rho if rho.ndim == 0 else rho[self._surface_edges[:, 0]]
-            g = self._surface_factor
-            with np.errstate(divide="ignore"):
-                c = np.concatenate([c, np.where(g > 0, 1.0 / (rho_i / np.where(g > 0, g, 1.0) + self._surface_series),
-                                                0.0)])
+            c = np.concatenate([c, in_series(self._surface_factor / rho_i, self._surface_series if film else None)])
         return c
 
     @property

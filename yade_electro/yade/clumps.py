@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..network.lumping import member_volumes
-from .scene import ensure_thermal_state
+from .scene import TemperatureWriter
 
-__all__ = ["clump_volume_fraction", "write_clump_temperatures"]
+__all__ = ["clump_volume_fraction", "ClumpTemperatures"]
 
 
 def clump_volume_fraction(reader):
@@ -28,18 +28,28 @@ def clump_volume_fraction(reader):
     return fraction
 
 
-def write_clump_temperatures(O, reader, ids, temperature, capacity) -> int:
-    """Write on each clump body (``b.state.temp``) the capacity-weighted mean temperature [K]
-    of its members among the spheres of body ids ``ids``; returns how many clumps."""
-    labels = reader.clump_labels(ids)
-    member = labels >= 0
-    if not np.any(member):
-        return 0
-    clumps, inv = np.unique(labels[member], return_inverse=True)
-    C = np.asarray(capacity, float)[member]
-    T = np.bincount(inv, C * np.asarray(temperature, float)[member], clumps.size) / np.bincount(inv, C, clumps.size)
-    bodies = [O.bodies[int(c)] for c in clumps]
-    ensure_thermal_state(bodies)
-    for b, t in zip(bodies, T.tolist()):
-        b.state.temp = t
-    return int(clumps.size)
+class ClumpTemperatures:
+    """Writes on each clump body (``b.state.temp``) the capacity-weighted mean temperature [K]
+    of its members, through a :class:`~yade_electro.yade.scene.TemperatureWriter` whose kept
+    handles are the clump bodies of the reader's last full read (taken again only when the
+    element set changed)."""
+
+    def __init__(self):
+        self._writer = TemperatureWriter()
+        self._reads, self._clumps, self._bodies = None, None, []
+
+    def write(self, O, reader, ids, temperature, capacity) -> int:
+        """The clumps of the spheres of body ids ``ids`` with their members' ``temperature``
+        [K] and ``capacity`` [J/K]; returns how many clumps were written."""
+        labels = reader.clump_labels(ids)
+        member = labels >= 0
+        if not np.any(member):
+            return 0
+        clumps, inv = np.unique(labels[member], return_inverse=True)
+        if self._reads != reader.full_reads or not np.array_equal(clumps, self._clumps):
+            self._reads, self._clumps = reader.full_reads, clumps
+            self._bodies = [O.bodies[int(c)] for c in clumps]
+        C = np.asarray(capacity, float)[member]
+        T = np.bincount(inv, C * np.asarray(temperature, float)[member], clumps.size) / np.bincount(inv, C, clumps.size)
+        self._writer.write(self._bodies, T)
+        return int(clumps.size)

@@ -18,7 +18,7 @@ from ..network.heat_conditions import ThermalWall
 from . import persistence
 from . import registry
 from .runtime import import_yade
-from .clumps import clump_volume_fraction, write_clump_temperatures
+from .clumps import ClumpTemperatures, clump_volume_fraction
 from .granular import check_wall_bodies
 from .scene import TemperatureWriter, write_body_attribute
 
@@ -199,6 +199,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                                            **extra)
         self._last_time = float(self.O.time)
         self._temperature_writer = TemperatureWriter()
+        self._clump_writer = ClumpTemperatures()
         if initial_temperature is not None and _resume is None:
             self.coupled.restore_temperatures(self._initial_temperatures(initial_temperature, temperature))
         if _resume is not None:
@@ -437,7 +438,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         bodies = self.reader.bodies
         self._temperature_writer.write(bodies, self.coupled.temperature)
         if getattr(self.reader, "has_clumps", False):       # and on each clump body: its members' mean
-            write_clump_temperatures(self.O, self.reader, graph.ids, self.coupled.temperature, self.coupled.capacity)
+            self._clump_writer.write(self.O, self.reader, graph.ids, self.coupled.temperature, self.coupled.capacity)
         sol = self.coupled.solution
         if self.write_back and sol is not None and sol is not self._written:
             write_body_attribute(bodies, self.write_back, sol.potential)
