@@ -9,7 +9,7 @@ import json
 import numpy as np
 from yade import pack, utils
 
-from yade_electro.yade import HeatEngine, Integrator, Material, Output, Reader, Wall
+from yade_electro.yade import HeatEngine, Integrator, Law, Material, Output, Reader, Wall
 
 T_BED, T_FLOOR, SIDE = 293.15, 373.15, 0.012                       # K, K, box side [m]
 O.materials.append(FrictMat(young=1e7, poisson=0.3, density=8900, frictionAngle=0.5, label="copper"))
@@ -30,6 +30,9 @@ heat = HeatEngine(
     material=Material(density=8900.0, specific_heat=385.0, conductivity=400.0),
     boundaries=[Wall("floor", bodies=floor, temperature=T_FLOOR)],      # walls not named: adiabatic
     temperature=T_BED,
+    # the contact radius a of g = 2 a: the lens where the two spheres' surfaces cross (the
+    # default; for equal spheres sqrt(2) times Hertz's a = sqrt(R* delta)); radius="hertz" for Hertz
+    law=Law("contact", radius="geometric"),
     integrator=Integrator(theta="explicit"),               # sub-cycled to its stable step by itself
     reader=Reader(bonds="contacts"),
     output=Output(history="bed.csv"),

@@ -33,7 +33,7 @@ try:
                reader=Reader(bonds="contacts"), temperature=300.0)
 except GraphError as exc:
     print("REFUSED", exc)
-for kw in (dict(bonds="contacts", clumps="merged"), dict(clumps="lumped")):
+for kw in (dict(bonds="contacts", clumps="merged"),):
     try:
         Reader(**kw)
     except ValueError as exc:
@@ -44,11 +44,10 @@ for kw in (dict(bonds="contacts", clumps="merged"), dict(clumps="lumped")):
 def test_clumps_the_engine_refuses_when_built(run_yade_script):
     res = run_yade_script(BAD_CLUMPS, check=True, timeout=300)
     lines = [ln for ln in res.stdout.splitlines() if ln.startswith("REFUSED")]
-    assert len(lines) == 4, res.stdout[-2000:]
+    assert len(lines) == 3, res.stdout[-2000:]
     assert "is a Box, not a sphere" in lines[0] and "appendClumped" in lines[0]
     assert "has no mass" in lines[1] and "density > 0" in lines[1]
     assert "'lumped' (one temperature per clump) or 'resolved'" in lines[2]
-    assert "for granular beds (bonds='contacts')" in lines[3]
 
 
 FALLING_CLUMPS = """

@@ -3,6 +3,7 @@
 Euler step, a deck that fails and whose ERROR line reaches the caller, a timeout, a missing
 binary and a packing settled in a cylinder."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -248,3 +249,24 @@ def test_heat_deck_under_mpi_gives_the_same_temperatures(liggghts_exe, tmp_path)
     np.testing.assert_array_equal(tables[2].to_numpy(), tables[1].to_numpy())
     with pytest.raises(ValueError, match="ranks must be a whole number >= 1"):
         L.run_heat_conduction(deck, tmp_path / "bad", exe=liggghts_exe, progress=None, ranks=0)
+
+
+def test_names_cannot_reach_the_deck_or_leave_the_work_directory(liggghts_exe, tmp_path):
+    """Issue 36, item 8: a mesh path with a space and an embedded LIGGGHTS command works (the
+    mesh is copied under the deck's own name) and runs nothing; file names with folder parts
+    and values carrying a 'shell' command are refused."""
+    odd = tmp_path / "my plates" / "plate x\nshell touch PWNED.stl"
+    odd.parent.mkdir()
+    odd.write_text(PLATE_STL)
+    box = [[-0.01, 0.01]] * 2 + [[-0.005, 0.01]]
+    d = L.particle_data([[0, 0, 1.9e-3]], 2e-3, 8900.0, box=box)
+    deck = L.heat_conduction_deck(d, [COPPER], 273.15, 1e-6, 20, 10, walls=[L.MeshWall(str(odd), temperature=373.15)])
+    assert "PWNED" not in deck.deck and "wall_mesh0.stl" in deck.deck
+    L.run_heat_conduction(deck, tmp_path / "run", exe=liggghts_exe, progress=None)
+    assert not list(tmp_path.rglob("PWNED*")) and not (Path.cwd() / "PWNED").exists()
+    for bad in ("../escape.in", "/tmp/abs.data", "two words.data", ".hidden"):
+        with pytest.raises(ValueError, match="not a plain file name"):
+            L.run_deck("run 0", tmp_path / "w", files={bad: "x"}, exe=liggghts_exe)
+    assert not (tmp_path / "escape.in").exists()
+    with pytest.raises(ValueError, match="'shell' command"):
+        L.render_deck("heat_conduction", data_file="x", walls="fix a all nve\nshell rm -rf /")

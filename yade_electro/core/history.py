@@ -89,15 +89,28 @@ class History:
         os.makedirs(d, exist_ok=True)
 
     def _read_back(self):
+        rows = []
         with open(self.path, newline="") as fh:
-            rows = list(csv.reader(fh))
+            reader = csv.reader(fh)
+            try:
+                for r in reader:
+                    rows.append(r)
+            except (csv.Error, UnicodeDecodeError) as exc:
+                raise ValueError(f"history file {self.path!r}, line {reader.line_num}: {exc}. It is not a history "
+                                 "this package wrote, or it is damaged: give another history path, or "
+                                 "history_mode='w' to replace it") from None
         if not rows:
             return
         self._fields = rows[0]
-        for r in rows[1:]:
+        skipped = []
+        for n, r in enumerate(rows[1:], start=2):
             if len(r) != len(self._fields):
+                skipped.append(n)
                 continue
             self.rows.append({k: _parse(v) for k, v in zip(self._fields, r)})
+        if skipped:
+            warnings.warn(f"history file {self.path!r}: rows {skipped[:10]} do not have the header's "
+                          f"{len(self._fields)} fields (a write cut short?) and are left out", stacklevel=4)
         self._written = len(self.rows)
 
     def _try(self, fn) -> bool:

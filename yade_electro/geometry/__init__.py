@@ -13,7 +13,8 @@ from .contacts import (sphere_tree, candidate_pairs, periodic_candidate_pairs, c
                        plane_contact_radius, triangle_distance, quaternion_matrices, facet_vertices)
 from .ghosts import ghost_points, tessellate_with_ghosts, progress_lines
 from .shapes import (Shape, Cylinder, Box, Sphere, Difference, Intersection, Union, GridShape, as_shape,
-                     container_volume, as_surface)
+                     as_surface)
+from .volumes import container_volume
 from .surface_mesh import MeshShape, read_stl
 from .surfaces import SurfaceSelector, Plane, OnSurface
 from .tessellation import Tessellation, tessellate, circumcentres

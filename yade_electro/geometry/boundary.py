@@ -121,6 +121,19 @@ def surface_contact(cells, pos, surface, name: str = "surface", what: str = "ele
     sel = as_surface(surface)
     pos = np.asarray(pos, float)
     on = np.asarray(sel(cells.boundary_point, cells.boundary_normal), bool)
+    facing = getattr(sel, "normal", None)
+    if facing is not None and container is not None and hasattr(container, "gradient") and np.any(on):
+        # a plane holds the container's faces that face its way: not the slivers of a wall it
+        # cuts across (a plane inside the solid, or given a wide tolerance)
+        g = np.asarray(container.gradient(cells.boundary_point[on]), float)
+        g = g / np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
+        across = g @ np.asarray(facing, float) <= 0.5
+        if np.all(across):
+            raise BoundaryConditionError(
+                f"{what} {name!r}: the surface {sel!r} crosses the container's surface only where that faces "
+                "another way (a plane inside the solid, or a tolerance wider than the elements): give a face of the "
+                "container, e.g. container.face('top')")
+        on[np.flatnonzero(on)[across]] = False
     if not np.any(on):
         raise BoundaryConditionError(
             f"{what} {name!r}: the surface {sel!r} holds none of the packing's boundary faces (it is not on the "
@@ -140,6 +153,19 @@ def surface_contact(cells, pos, surface, name: str = "surface", what: str = "ele
     g = np.bincount(k, area / length, nodes.size)
     depth = np.bincount(k, area * d, nodes.size) / A
     return SurfaceContact(name, nodes, A, g, depth, area, length, k)
+
+
+def shared_faces(a: SurfaceContact, b: SurfaceContact, ids_a=None, ids_b=None) -> int:
+    """How many boundary faces two surface contacts both hold (the same element's face of the
+    same area and depth); the elements are compared by index, or by ``ids_a``/``ids_b`` (the
+    body ids of each contact's nodes) when given."""
+    na = np.asarray(a.nodes if ids_a is None else ids_a)[a.face_slot]
+    nb = np.asarray(b.nodes if ids_b is None else ids_b)[b.face_slot]
+    common = np.intersect1d(na, nb)
+    if not common.size:
+        return 0
+    ka = {(int(n), float(x), float(y)) for n, x, y in zip(na, a.face_area, a.face_depth) if n in set(common.tolist())}
+    return sum((int(n), float(x), float(y)) in ka for n, x, y in zip(nb, b.face_area, b.face_depth))
 
 
 @dataclass(frozen=True, eq=False)
@@ -216,8 +242,9 @@ def boundary_areas(cells, n: int):
 
 class BoundaryOfGraph:
     """The bounded cells of a graph's elements in a container, made once per element set (on
-    the first graph, or on ``reference`` (ids, pos, radius) when it holds the same elements)
-    and shared (a 'voronoi' law with the same container gives its own)."""
+    the first graph, or on ``reference`` (ids, pos, radius) when it holds the same elements;
+    a later set taken back to the container's frame by the solid's rigid motion since) and
+    shared (a 'voronoi' law with the same container gives its own)."""
 
     def __init__(self, container, law=None):
         if container is None or not (hasattr(container, "sdf") and hasattr(container, "gradient")):
@@ -235,7 +262,12 @@ class BoundaryOfGraph:
         key = graph.ids.tobytes()
         if self._key != key:
             from .cells import bounded_cells
-            self._cells = bounded_cells(graph.pos, graph.radius, self.container)
-            self._pos = np.array(graph.pos)
+            from .rigid import back_to_reference
+            pos = np.array(graph.pos)
+            if self._key is not None:     # the solid moved since: back to the container's frame
+                back = back_to_reference(self._ids, self._pos, graph.ids, pos, 1e-9 * float(np.max(graph.radius)))
+                pos = pos if back is None else back
+            self._cells = bounded_cells(pos, graph.radius, self.container)
+            self._pos, self._ids = pos, np.array(graph.ids)
             self._key = key
         return self._cells, self._pos

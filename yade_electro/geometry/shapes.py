@@ -23,7 +23,7 @@ import numpy as np
 from .surfaces import OnSurface, Plane, SurfaceSelector
 
 __all__ = ["Shape", "Cylinder", "Box", "Sphere", "Difference", "Intersection", "Union", "GridShape",
-           "as_shape", "container_volume"]
+           "as_shape"]
 
 log = logging.getLogger(__name__)
 
@@ -348,13 +348,51 @@ class _Binary(Shape):
     def parts(self):
         return (self.a, self.b)
 
+    #: the faces of ``b`` face the other way on the combined surface (a difference's cut)
+    _flip_b = False
+
+    def face(self, name: str, tol=None) -> "SurfaceSelector":
+        """A face of one of the shapes this one is made of: ``name`` as that shape names it
+        (``'top'``, ``'x+'``, ...) when one part alone has it, or ``'a.<name>'`` /
+        ``'b.<name>'`` for the first or second part (nested: ``'a.b.top'``). A face of what a
+        difference cuts away faces out of the remaining solid (its normal turned round)."""
+        if not isinstance(name, str):
+            raise ValueError(f"a face is named by a string, got {name!r}")
+        head, _, rest = name.partition(".")
+        if head in ("a", "b") and rest:
+            sel = getattr(self, head).face(rest, tol)
+            return _turned(sel) if head == "b" and self._flip_b else sel
+        found, errors = [], []
+        for key, part in (("a", self.a), ("b", self.b)):
+            try:
+                sel = part.face(name, tol)
+            except (AttributeError, ValueError) as exc:
+                errors.append(f"{key}: {exc}" if not isinstance(exc, AttributeError) else f"{key}: {part!r} has no faces")
+                continue
+            found.append((key, _turned(sel) if key == "b" and self._flip_b else sel))
+        if len(found) == 1:
+            return found[0][1]
+        if found:
+            raise ValueError(f"both parts of {self!r} have a face {name!r}: name it 'a.{name}' or 'b.{name}'")
+        raise ValueError(f"no part of {type(self).__name__} has a face {name!r} ({'; '.join(errors)})")
+
     def __repr__(self):
         return f"{type(self).__name__}({self.a!r}, {self.b!r})"
 
 
+def _turned(sel):
+    """The surface selector ``sel`` with the faces' normals turned round (a cut's faces)."""
+    if isinstance(sel, Plane):
+        return Plane(sel.point, -sel.normal, sel.tol)
+    return SurfaceSelector(lambda p, n: sel(p, -np.asarray(n, float)), f"{sel!r}, facing out of the difference")
+
+
 class Difference(_Binary):
     """Points of ``a`` not in ``b`` (a notched bar: ``bar - notch``). The signed distance
-    ``max(sdf_a, -sdf_b)`` is exact inside, a bound outside."""
+    ``max(sdf_a, -sdf_b)`` is exact inside, a bound outside. Faces: ``a``'s, and ``b``'s
+    facing out of the remaining solid (:meth:`_Binary.face`)."""
+
+    _flip_b = True
 
     def sdf(self, x):
         return np.maximum(self.a.sdf(x), -self.b.sdf(x))
@@ -525,32 +563,6 @@ def as_shape(predicate, voxel=None, bounds=None) -> Shape:
         voxel = float(np.max(b[1] - b[0])) / 100.0
     log.info("as_shape: %s not recognised, sampling it on a grid (voxel %.3g m)", name, voxel)
     return GridShape(predicate, b, voxel)
-
-
-def container_volume(shape, n_samples=4_000_000, seed=20240607) -> tuple:
-    """Volume of a container [m^3] and the method used.
-
-    Exact for :class:`Cylinder`, :class:`Box`, :class:`Sphere`. Otherwise Monte Carlo with
-    ``n_samples`` uniform points in the bounding box and a fixed ``seed`` (relative standard
-    error ``sqrt((1-p)/(p n))`` for an inside fraction ``p``, about 3e-4 for a notched bar).
-
-    Returns
-    -------
-    (volume, method) : (float, str)
-        ``method`` is ``"exact"`` or ``"monte-carlo(n=..., seed=...)"``.
-    """
-    shape = as_shape(shape)
-    v = shape.exact_volume
-    if v is not None:
-        return float(v), "exact"
-    lo, hi = shape.bounds()
-    rng = np.random.default_rng(seed)
-    hits, done, batch = 0, 0, 500_000
-    while done < n_samples:
-        m = min(batch, n_samples - done)
-        hits += int(np.count_nonzero(shape.sdf(lo + (hi - lo) * rng.random((m, 3))) <= 0))
-        done += m
-    return float(np.prod(hi - lo) * hits / n_samples), f"monte-carlo(n={n_samples}, seed={seed})"
 
 
 def as_surface(surface) -> SurfaceSelector:

@@ -4,7 +4,8 @@ material value (g / rho_e, lambda g).
 """
 from .factors import (conductance, geometric_factor, conductance_laws, register_conductance_law, make_law,
                       check_law_name, is_contact_law, unregister_conductance_law, contact_radius,
-                      edge_lengths, ConductanceLaw, FactorNetwork)
+                      edge_lengths, ConductanceLaw)
+from .factor_network import FactorNetwork
 from .law import Law
 from .transmission import (POLYHEDRON_FACES, POLYHEDRON_ALPHA, POLYHEDRON_FV, polyhedron_alpha,
                            polyhedron_volume_fraction, eccentricity, eccentricity_factor,

@@ -49,13 +49,13 @@ from typing import Callable, Dict
 
 import numpy as np
 
-from ..core.errors import MaterialError
+from ..core.errors import GraphError, MaterialError
 from ..core.graph import ContactGraph
 from ..core.materials import electrical_conductance, positive_property
 from .transmission import edge_transmission_surface, polyhedron_alpha
 
 __all__ = ["conductance", "geometric_factor", "conductance_laws", "register_conductance_law", "make_law",
-           "check_law_name", "needs_container", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
+           "check_law_name", "needs_container", "law_attribute", "is_contact_law", "unregister_conductance_law", "contact_radius", "edge_lengths", "ConductanceLaw"]
 
 _LAWS: Dict[str, Callable] = {}
 
@@ -94,6 +94,16 @@ def needs_container(law) -> bool:
         return bool(law.needs_container)
     check_law_name(law)
     return bool(getattr(_LAWS[law], "needs_container", False))
+
+
+def law_attribute(law, name: str, default=None):
+    """A class attribute of the law ``law`` (a name or a law object): e.g. ``cell_volumes``
+    (the law makes its elements' cell volumes, hence the capacities) or ``clumps`` (the clump
+    mode its reader must have)."""
+    if isinstance(law, ConductanceLaw):
+        return getattr(law, name, default)
+    check_law_name(law)
+    return getattr(_LAWS[law], name, default)
 
 
 def is_contact_law(law) -> bool:
@@ -439,7 +449,9 @@ class VoronoiLaw(ConductanceLaw):
     def faces(self, graph: ContactGraph):
         """The kept tessellation's faces, made once per element set: on ``reference`` (ids,
         pos, radius) when it holds the same elements (a resumed run), else on the first graph
-        of the set."""
+        of the set, taken back to the container's frame by the rigid motion of the elements it
+        shares with the last reference (:func:`~yade_electro.geometry.rigid.back_to_reference`:
+        a solid moved as a whole and then restructured keeps its cells)."""
         key = graph.ids.tobytes()
         if self._key != key:
             from ..geometry.voronoi import VoronoiFaces
@@ -449,6 +461,12 @@ class VoronoiLaw(ConductanceLaw):
                 base = ContactGraph(ref[1], ref[2], bonds, ref[0])
             else:
                 base = graph
+                if ref is not None:       # the solid moved since: back to the container's frame
+                    from ..geometry.rigid import back_to_reference
+                    back = back_to_reference(ref[0], ref[1], graph.ids, graph.pos,
+                                             1e-9 * float(np.max(graph.radius)) if graph.n_nodes else 0.0)
+                    if back is not None:
+                        base = ContactGraph(back, graph.radius, graph.edges, graph.ids)
             self._faces = VoronoiFaces.of(base, self.container, self.radius_range, self.bounds)
             self.reference = (base.ids.copy(), np.array(base.pos), np.array(base.radius), np.array(base.edges))
             self._key = key
@@ -475,8 +493,17 @@ class VoronoiLaw(ConductanceLaw):
         return self._area_of_edges / edge_lengths(graph, edges)
 
     def cell_volumes(self, graph) -> np.ndarray:
-        """Bounded Voronoi cell volumes [m^3] from the kept tessellation."""
-        return self.faces(graph).cell_volumes()
+        """Bounded Voronoi cell volumes [m^3] from the kept tessellation; GraphError naming the
+        elements whose cell is empty (they lie outside the container)."""
+        v = self.faces(graph).cell_volumes()
+        bad = ~(np.isfinite(v) & (v > 0))
+        if np.any(bad):
+            ids = np.asarray(graph.ids)[bad]
+            raise GraphError(f"{ids.size} element(s) have no cell inside the container, so no volume and no heat "
+                             f"capacity: bodies {ids[:10].tolist()}{' ...' if ids.size > 10 else ''} lie outside the "
+                             "solid (a loose sphere dropped outside it?). Leave them out of the engine (a mask, or "
+                             "Reader(isolated='leave out') when they have no bond), or erase them")
+        return v
 
 
 def geometric_factor(graph: ContactGraph, law="continuum", **params) -> np.ndarray:
@@ -502,71 +529,3 @@ def conductance(graph: ContactGraph, resistivity, law="continuum", **params) -> 
     if not np.all(np.isfinite(c)) or np.any(c < 0):
         raise MaterialError(f"conductance law {law.name!r} produced non-finite or negative values")
     return c
-
-
-class FactorNetwork:
-    """A law's network on a changing graph, kept with its geometric factors.
-
-    ``update(graph)`` compares the graph with the previous one and returns what changed:
-
-    * ``None``: nothing (same object, or same elements, bonds and positions);
-    * ``'geometry'``: the elements moved (or their periodic images, or their radii changed):
-      new factors g on the same edges;
-    * ``'topology'``: the bonds changed and the law's new network is a subset of the kept
-      edges (bonds broke): the lost edges get g = 0, the edge list stays;
-    * ``'structure'``: another element set, or new edges: a new edge list.
-
-    Attributes
-    ----------
-    edges : (m, 2) the kept edges (node pairs of ``graph``)
-    factor : (m,) g on ``edges`` [m] (0 on edges the law no longer conducts through)
-    graph : the graph of the last update
-    """
-
-    def __init__(self, law: ConductanceLaw):
-        self.law = law
-        self.graph: ContactGraph = None
-        self.edges = None
-        self.factor = None
-        self._net = None
-        self._slots = None
-        self._pos = self._shift = self._radius = None
-
-    def update(self, graph: ContactGraph):
-        from ..core.graph import edge_slots
-        old = self.graph
-        if old is not None and graph is old:
-            return None
-        self.graph = graph
-        if old is None or graph.n_nodes != old.n_nodes or not np.array_equal(graph.ids, old.ids):
-            self._rebuild(graph)
-            return "structure"
-        same_bonds = graph.edges is old.edges or np.array_equal(graph.edges, old.edges)
-        moved = not (graph.pos is self._pos or np.array_equal(graph.pos, self._pos)) or not (
-            graph.shift is self._shift or (graph.shift is not None and self._shift is not None
-                                           and np.array_equal(graph.shift, self._shift))) or not (
-            graph.radius is self._radius or np.array_equal(graph.radius, self._radius))
-        if same_bonds and not moved:
-            return None
-        kind = "geometry"
-        if not same_bonds:
-            net = self.law.network(graph)
-            slots = edge_slots(self.edges, net, graph.n_nodes)
-            if slots is None:
-                self._rebuild(graph)
-                return "structure"
-            self._net, self._slots = net, slots
-            kind = "topology"
-        g = np.zeros(self.edges.shape[0])
-        g[self._slots] = self.law.factor(graph, self._net)
-        self.factor, self._pos, self._shift, self._radius = g, graph.pos, graph.shift, graph.radius
-        return kind
-
-    def _rebuild(self, graph):
-        net = self.law.network(graph)
-        self.edges, self._net, self._slots = net, net, np.arange(net.shape[0])
-        self.factor = self.law.factor(graph, net)
-        self._pos, self._shift, self._radius = graph.pos, graph.shift, graph.radius
-
-
-__all__ += ["FactorNetwork"]

@@ -148,9 +148,19 @@ def read_data(path) -> ParticleData:
             continue
         words = line.split()
         if line.endswith("atoms") and len(words) == 2:
-            n_atoms = int(words[0])
+            try:
+                n_atoms = int(words[0])
+            except ValueError:
+                raise ValueError(f"{path}:{k}: the atom count {words[0]!r} is not a whole number") from None
         elif len(words) == 4 and words[2][1:] == "lo" and words[2][0] in "xyz":
-            box["xyz".index(words[2][0])] = [float(words[0]), float(words[1])]
+            try:
+                lo, hi = float(words[0]), float(words[1])
+            except ValueError:
+                lo = hi = float("nan")
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                raise ValueError(f"{path}:{k}: the box bounds {words[0]} {words[1]} along {words[2][0]} are not finite "
+                                 "numbers with lo < hi")
+            box["xyz".index(words[2][0])] = [lo, hi]
         elif line in sections:
             rows_here = []
             while k < len(text) and not text[k].strip():
@@ -164,6 +174,10 @@ def read_data(path) -> ParticleData:
         raise ValueError(f"{path} is not a LIGGGHTS data file with an Atoms section")
     if len(rows) != n_atoms:
         raise ValueError(f"{path}: the header says {n_atoms} atoms, the Atoms section has {len(rows)}")
+    short = [r for r in rows if len(r) < 7]
+    if short:
+        raise ValueError(f"{path}: an Atoms line has {len(short[0])} values ({' '.join(short[0])!r}): they need 7, "
+                         "id type diameter density x y z (atom_style granular); is the file cut short?")
     try:
         table = np.array([[float(v) for v in r[:7]] for r in rows])
     except ValueError as exc:
@@ -171,5 +185,9 @@ def read_data(path) -> ParticleData:
     if table.shape[1] != 7:
         raise ValueError(f"{path}: Atoms lines need 7 columns (id type diameter density x y z, atom_style "
                          "granular)")
+    bad = ~np.all(np.isfinite(table), axis=1) | (table[:, 2] <= 0) | (table[:, 3] <= 0)
+    if np.any(bad):
+        raise ValueError(f"{path}: atoms {table[bad, 0][:5].tolist()} have a value that is not finite, or a diameter or "
+                         "density <= 0")
     return ParticleData(ids=table[:, 0].astype(np.int64), types=table[:, 1].astype(np.int64),
                         radius=0.5 * table[:, 2], density=table[:, 3], positions=table[:, 4:7], box=box)

@@ -9,6 +9,7 @@ initial temperatures) are made by the functions here, so the templates hold no l
 """
 from __future__ import annotations
 
+import re
 import string
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,7 +18,7 @@ from typing import Optional, Sequence, Tuple
 import numpy as np
 
 __all__ = ["TEMPLATE_DIR", "DeckTemplate", "template_names", "render_deck", "GranularMaterial",
-           "PlaneWall", "CylinderWall", "MeshWall", "material_commands", "wall_commands",
+           "PlaneWall", "CylinderWall", "MeshWall", "material_commands", "wall_commands", "wall_files", "safe_file_name",
            "temperature_commands", "size_class_commands", "primes_from", "PAIR_LOCAL_ORDER", "pair_local_columns"]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
@@ -51,6 +52,9 @@ def render_deck(template, **values) -> str:
     A placeholder without a value, or a value no placeholder takes, raises ``ValueError``
     naming them."""
     text, where = _template_text(template)
+    for k, v in values.items():          # a value must not bring its own commands
+        if _SHELL.search(str(v)):
+            raise ValueError(f"the value of {k!r} holds a LIGGGHTS 'shell' command: a deck never runs shell commands")
     tpl = DeckTemplate(text)
     wanted = {m.group("named") or m.group("braced") for m in tpl.pattern.finditer(text)} - {None}
     missing, unused = sorted(wanted - set(values)), sorted(set(values) - wanted)
@@ -59,6 +63,21 @@ def render_deck(template, **values) -> str:
     if unused:
         raise ValueError(f"template {where} has no placeholder for {unused} (it takes {sorted(wanted)})")
     return tpl.substitute({k: str(v) for k, v in values.items()})
+
+
+_SHELL = re.compile(r"(^|[\n\r&])\s*shell\b", re.IGNORECASE)
+_SAFE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.+-]*$")
+
+
+def safe_file_name(name, what: str = "a file of the run") -> str:
+    """``name`` when it is a plain file name that a deck can hold as one word and that stays in
+    the work directory (letters, digits, ``_ . + -``; no folder part, no space, no leading
+    dot or dash); ValueError otherwise."""
+    text = str(name)
+    if not _SAFE_NAME.match(text) or text in (".", "..") or ".." in text.split("."):
+        raise ValueError(f"{what}: {text!r} is not a plain file name (letters, digits, _ . + -, no folder part or "
+                         "space): it goes into the deck as one word and is written inside the work directory")
+    return text
 
 
 def _num(x) -> str:
@@ -169,7 +188,9 @@ class CylinderWall:
 
 @dataclass(frozen=True)
 class MeshWall:
-    """A triangle mesh from an STL file [m after ``scale``]."""
+    """A triangle mesh from an STL file [m after ``scale``]. The file is copied into the run's
+    work directory under a name of the deck's own (:func:`wall_files`), so that any path works
+    (spaces, folders) and nothing of it reaches the deck."""
 
     stl: str
     scale: float = 1.0
@@ -189,14 +210,25 @@ def wall_commands(walls, contact_model: str = "hertz") -> str:
             lines.append(f"{head} primitive type {w.atom_type} {w.axis}cylinder {_num(w.radius)} "
                          f"{_num(w.center[0])} {_num(w.center[1])}{temp}")
         elif isinstance(w, MeshWall):
-            if not Path(w.stl).exists():
-                raise FileNotFoundError(f"STL mesh {w.stl} of a MeshWall not found")
-            lines.append(f"fix mesh{k} all mesh/surface file {w.stl} type {w.atom_type} scale {_num(w.scale)}"
-                         f"{temp}")
+            if not Path(w.stl).is_file():
+                raise FileNotFoundError(f"STL mesh {w.stl!r} of a MeshWall not found")
+            lines.append(f"fix mesh{k} all mesh/surface file {_mesh_name(k)} type {int(w.atom_type)} "
+                         f"scale {_num(w.scale)}{temp}")
             lines.append(f"{head} mesh n_meshes 1 meshes mesh{k}")
         else:
             raise TypeError(f"walls must be PlaneWall, CylinderWall or MeshWall, got {w!r}")
     return "\n".join(lines) if lines else "# no walls"
+
+
+def _mesh_name(k: int) -> str:
+    return f"wall_mesh{k}.stl"
+
+
+def wall_files(walls) -> dict:
+    """{name in the work directory: path of the STL file} of the walls' meshes (what
+    :func:`wall_commands` names), for :func:`~yade_electro.liggghts.runner.run_deck`'s
+    ``files``."""
+    return {_mesh_name(k): Path(w.stl) for k, w in enumerate(walls or ()) if isinstance(w, MeshWall)}
 
 
 def temperature_commands(ids, temperatures) -> str:

@@ -46,9 +46,19 @@ def read_dump_frames(path, columns: Optional[Sequence[str]] = None) -> list:
                 raise ValueError(f"{path}:{k + 1}: expected 'ITEM: TIMESTEP', got {lines[k][:60]!r}")
             k += 1
             continue
-        step = int(lines[k + 1])
-        count = int(lines[k + 3])
-        box = np.array([[float(v) for v in lines[k + 5 + d].split()[:2]] for d in range(3)])
+        if k + 8 >= len(lines):
+            raise ValueError(f"{path}:{k + 1}: the snapshot's header is cut short ({len(lines) - k} of its 9 lines): "
+                             "the run stopped while writing it")
+        try:
+            step = int(lines[k + 1])
+            count = int(lines[k + 3])
+            box = np.array([[float(v) for v in lines[k + 5 + d].split()[:2]] for d in range(3)])
+        except ValueError as exc:
+            raise ValueError(f"{path}:{k + 1}: a snapshot header that is not TIMESTEP / NUMBER / BOX BOUNDS "
+                             f"({exc}): the file is damaged or not a LIGGGHTS dump") from None
+        if box.shape != (3, 2) or count < 0:
+            raise ValueError(f"{path}:{k + 1}: a snapshot header with {count} rows and box {box.tolist()}: the file is "
+                             "damaged or not a LIGGGHTS dump")
         head = lines[k + 8].split()
         if head[:2] != ["ITEM:", head[1]] or head[1] not in ("ATOMS", "ENTRIES"):
             raise ValueError(f"{path}:{k + 9}: expected 'ITEM: ATOMS' or 'ITEM: ENTRIES', got {lines[k + 8][:60]!r}")
@@ -57,9 +67,16 @@ def read_dump_frames(path, columns: Optional[Sequence[str]] = None) -> list:
         if len(rows) != count:
             raise ValueError(f"{path}: snapshot at step {step} is cut short ({len(rows)} of {count} rows): the run "
                              "stopped while writing it")
-        table = (np.array([r.split() for r in rows], dtype=float) if count else np.zeros((0, len(names))))
-        if table.shape[1] != len(names):
-            raise ValueError(f"{path}: step {step} has {table.shape[1]} columns for {len(names)} names")
+        split = [r.split() for r in rows]
+        short = [i for i, r in enumerate(split) if len(r) != len(names)]
+        if short:
+            i = short[0]
+            raise ValueError(f"{path}:{k + 10 + i}: step {step} has a row of {len(split[i])} values for {len(names)} "
+                             "columns (a line cut short: the run stopped while writing it?)")
+        try:
+            table = np.array(split, dtype=float) if count else np.zeros((0, len(names)))
+        except ValueError as exc:
+            raise ValueError(f"{path}: step {step} has a value that is not a number ({exc})") from None
         if columns is not None:
             if len(columns) != len(names):
                 raise ValueError(f"{path}: {len(columns)} column names given for {len(names)} columns {names}")

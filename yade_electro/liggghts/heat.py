@@ -17,7 +17,7 @@ from typing import Dict, Optional, Sequence
 
 from .datafile import ParticleData, format_data
 from .deck import GranularMaterial, material_commands, pair_local_columns, render_deck, temperature_commands, \
-    wall_commands
+    wall_commands, wall_files
 from .dumps import read_dump
 from .runner import LiggghtsRun, run_deck
 
@@ -97,6 +97,7 @@ def heat_conduction_deck(data: ParticleData, materials: Sequence[GranularMateria
         raise ValueError(f"initial_temperature names atom ids not in the data: {unknown[:5]}")
     files = {"particles.data": format_data(data)}
     files["temperatures.set"] = temperature_commands(list(init), list(init.values()))
+    files.update(wall_files(walls))
     cols = pair_local_columns(HEAT_PAIR_KEYWORDS)
     deck = render_deck(
         "heat_conduction", data_file="particles.data",

@@ -118,8 +118,10 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     workdir : path
         Created if needed; the deck, its files, ``log.liggghts``, ``stdout.txt`` and the dumps
         are there.
-    files : dict name -> str, optional
-        Further input files (data file, included command files).
+    files : dict name -> str, bytes or path, optional
+        Further input files (data file, included command files, meshes to copy), each name a
+        plain file name (:func:`~yade_electro.liggghts.deck.safe_file_name`: it stays in
+        ``workdir``).
     exe : str, optional
         LIGGGHTS binary (see :func:`find_liggghts`).
     timeout : float
@@ -137,11 +139,19 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     ------
     LiggghtsNotFound, LiggghtsError
     """
+    from .deck import safe_file_name
     binary = find_liggghts(exe)
+    for name in list(files or {}) + [deck_name]:
+        safe_file_name(name, "run_deck")
     work = Path(workdir)
     work.mkdir(parents=True, exist_ok=True)
-    for name, text in (files or {}).items():
-        (work / name).write_text(text)
+    for name, content in (files or {}).items():
+        if isinstance(content, (bytes, bytearray)):
+            (work / name).write_bytes(bytes(content))
+        elif isinstance(content, os.PathLike):
+            shutil.copyfile(content, work / name)
+        else:
+            (work / name).write_text(content)
     deck_path = work / deck_name
     deck_path.write_text(deck)
     log, out = work / "log.liggghts", work / "stdout.txt"

@@ -15,7 +15,8 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from .deck import GranularMaterial, material_commands, primes_from, render_deck, size_class_commands, wall_commands
+from .deck import (GranularMaterial, material_commands, primes_from, render_deck, size_class_commands, wall_commands,
+                   wall_files)
 from .dumps import read_dump_frames
 from .runner import LiggghtsRun, run_deck
 
@@ -128,7 +129,8 @@ def settle_packing(walls, region, n_particles: int, radii, mass_fractions, mater
     deck = settle_deck(walls, region, n_particles, radii, mass_fractions, material, box, timestep,
                        settle_time=settle_time, **deck_options)
     total = int(round(settle_time / timestep)) + int(round(deck_options.get("insert_time", INSERT_TIME) / timestep))
-    run = run_deck(deck, workdir, exe=exe, timeout=timeout, progress=progress, total_steps=total, total_is_bound=True)
+    run = run_deck(deck, workdir, files=wall_files(walls), exe=exe, timeout=timeout, progress=progress,
+                   total_steps=total, total_is_bound=True)
     frame = read_dump_frames(run.workdir / "settled.dump")[-1]
     df = frame.data
     m = re.search(r"YADE_ELECTRO_END step (\d+) ke_per_particle (\S+)", run.text())

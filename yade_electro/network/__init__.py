@@ -17,6 +17,7 @@ from .records import PotentialSolution, ThermalState, HeatStep, SteadyHeat, read
 from .structure import Words, GENERIC_WORDS, NetworkStructure
 from .theta import theta_of, stable_time_step, THETA_NAMES
 from .transient import HeatSolver
+from . import grain_law as _grain_law     # registers the 'grains' law  # noqa: F401
 
 __all__ = ["boundary_value", "check_place", "check_area", "terminal_number", "Condition", "TerminalRole", "FixedValue",
            "Terminal", "Injection", "Robin", "Source", "generic", "check_condition", "ReducedSystem", "FixedTemperature", "ThermalWall",

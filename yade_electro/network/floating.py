@@ -27,8 +27,8 @@ from scipy.sparse.csgraph import connected_components
 
 from ..solvers.registry import make_solver
 
-__all__ = ["floating_message", "warn_floating", "no_steady_state_message", "floating_parts", "hold_at_mean",
-           "solve_with_floating"]
+__all__ = ["floating_message", "warn_floating", "no_steady_state_message", "which_elements", "floating_parts",
+           "hold_at_mean", "solve_with_floating"]
 
 
 def floating_message(n_nodes: int, n_parts: int, reached: str, kept: str) -> str:
@@ -49,8 +49,26 @@ def no_steady_state_message(n_nodes: int, n_parts: int, reached: str, inflow: st
             f"is not defined ({inflow} has nowhere to go). {remedy}")
 
 
+def which_elements(names, mask, labels=None, alone_remedy: str = "leave them out of the model",
+                   limit: int = 10) -> str:
+    """The words that name the elements of ``mask`` by ``names`` (their body ids; '' without
+    names), and say how many stand alone (a part of one element: joined to nothing, e.g. a
+    particle with no bond) and what to do with those (``alone_remedy``)."""
+    if names is None or not np.any(mask):
+        return ""
+    ids = np.asarray(names)[np.asarray(mask, bool)]
+    out = f" Bodies: {ids[:limit].tolist()}{' ...' if ids.size > limit else ''}."
+    if labels is not None:
+        lab = np.asarray(labels)[np.asarray(mask, bool)]
+        _, count = np.unique(lab, return_counts=True)
+        alone = int(np.sum(count == 1))
+        if alone:
+            out += f" {alone} of them stand alone, joined to nothing (a particle with no bond?): {alone_remedy}."
+    return out
+
+
 def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_name: str, remedy: str,
-                   error=ValueError, stacklevel: int = 4):
+                   error=ValueError, stacklevel: int = 4, names=None, alone_remedy: str = "leave them out of the model"):
     """The floating unknowns of a network, by the policy above.
 
     Parameters
@@ -68,6 +86,9 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
         The words of the warning and of the error.
     error : exception class
         Raised for a floating part with an inflow.
+    names : (m,) optional
+        The unknowns' body ids, to name the floating ones (:func:`which_elements`), and
+        ``alone_remedy`` what to do with the ones joined to nothing.
 
     Returns
     -------
@@ -89,9 +110,14 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
     np.logical_or.at(fed, labels, np.asarray(inflow) != 0)
     bad = ~anchor & fed
     if np.any(bad):
-        raise error(no_steady_state_message(int(np.sum(bad[labels])), int(np.sum(bad)), reached, inflow_name, remedy))
+        raise error(no_steady_state_message(int(np.sum(bad[labels])), int(np.sum(bad)), reached, inflow_name, remedy)
+                    + which_elements(names, bad[labels], labels, alone_remedy))
     floating = ~anchor[labels]
-    warn_floating(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept, stacklevel=stacklevel)
+    if names is None:
+        warn_floating(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept, stacklevel=stacklevel)
+    else:
+        warnings.warn(floating_message(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept)
+                      + which_elements(names, floating, labels, alone_remedy), stacklevel=stacklevel)
     return labels, floating
 
 

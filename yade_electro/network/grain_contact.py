@@ -23,33 +23,15 @@ import numpy as np
 
 from ..core.errors import BoundaryConditionError
 
-__all__ = ["plane_contact_links", "mikic_resistance"]
+__all__ = ["plane_contact_geometry", "plane_contact_links", "contact_resistance_value", "mikic_resistance"]
 
 
-def plane_contact_links(centres_a, centres_b, origin, normal, u_axis, extent_u, extent_v, resistance,
-                        conductivity_a, conductivity_b=None, samples: int = 200_000, inside=None):
-    """Links across a flat contact: (pairs (k, 2) of element indices (of A, of B), conductances
-    G [W/K] (k,), the sampled contact area [m^2]).
-
-    Parameters
-    ----------
-    centres_a, centres_b : (n_a, 3), (n_b, 3) element centres [m] of the two grains
-    origin, normal : a point of the contact plane and its normal [m]
-    u_axis : a direction in the plane; v is normal x u
-    extent_u, extent_v : (lo, hi) of the contact region along u and v from ``origin`` [m]
-    resistance : the specific contact resistance R_c [m^2 K/W] >= 0
-    conductivity_a, conductivity_b : the grains' conductivities [W/(m K)] (B: A's by default)
-    samples : about how many sample points cover the region
-    inside : optional ``f(points (m, 3)) -> mask``: the points of the region that are in
-        contact (default all of it)
-    """
-    R = float(resistance)
-    if not (np.isfinite(R) and R >= 0):
-        raise BoundaryConditionError(f"a contact resistance must be finite and >= 0 (m^2 K/W), got {resistance!r}")
-    lam_a = float(conductivity_a)
-    lam_b = lam_a if conductivity_b is None else float(conductivity_b)
-    if not (lam_a > 0 and lam_b > 0):
-        raise BoundaryConditionError("the grains' conductivities must be > 0 (W/(m K))")
+def plane_contact_geometry(centres_a, centres_b, origin, normal, u_axis, extent_u, extent_v, samples: int = 200_000,
+                           inside=None):
+    """The geometry of a flat contact's links: (pairs (k, 2) of element indices (of A, of B),
+    their shared face areas ``A_ij`` [m^2] (k,), the elements' distances to the plane ``d_i``,
+    ``d_j`` [m] (k,) each, the sampled contact area [m^2]). Parameters as for
+    :func:`plane_contact_links`."""
     from scipy.spatial import cKDTree
     n = np.asarray(normal, float)
     n = n / np.linalg.norm(n)
@@ -73,11 +55,47 @@ def plane_contact_links(centres_a, centres_b, origin, normal, u_axis, extent_u, 
     key = ia.astype(np.int64) * cb.shape[0] + ib
     uniq, count = np.unique(key, return_counts=True)
     pairs = np.column_stack([uniq // cb.shape[0], uniq % cb.shape[0]])
-    A = count * dA
     da = np.abs((ca[pairs[:, 0]] - origin) @ n)
     db = np.abs((cb[pairs[:, 1]] - origin) @ n)
-    G = A / (da / lam_a + R + db / lam_b)
-    return pairs, G, float(pts.shape[0] * dA)
+    return pairs, count * dA, da, db, float(pts.shape[0] * dA)
+
+
+def contact_resistance_value(resistance) -> float:
+    """``resistance`` [m^2 K/W] as a float, checked finite and >= 0 (BoundaryConditionError)."""
+    try:
+        R = float(resistance)
+    except (TypeError, ValueError):
+        R = float("nan")
+    if not (np.isfinite(R) and R >= 0):
+        raise BoundaryConditionError(f"a contact resistance must be finite and >= 0 (m^2 K/W), got {resistance!r}")
+    return R
+
+
+def plane_contact_links(centres_a, centres_b, origin, normal, u_axis, extent_u, extent_v, resistance,
+                        conductivity_a, conductivity_b=None, samples: int = 200_000, inside=None):
+    """Links across a flat contact: (pairs (k, 2) of element indices (of A, of B), conductances
+    G [W/K] (k,), the sampled contact area [m^2]).
+
+    Parameters
+    ----------
+    centres_a, centres_b : (n_a, 3), (n_b, 3) element centres [m] of the two grains
+    origin, normal : a point of the contact plane and its normal [m]
+    u_axis : a direction in the plane; v is normal x u
+    extent_u, extent_v : (lo, hi) of the contact region along u and v from ``origin`` [m]
+    resistance : the specific contact resistance R_c [m^2 K/W] >= 0
+    conductivity_a, conductivity_b : the grains' conductivities [W/(m K)] (B: A's by default)
+    samples : about how many sample points cover the region
+    inside : optional ``f(points (m, 3)) -> mask``: the points of the region that are in
+        contact (default all of it)
+    """
+    R = contact_resistance_value(resistance)
+    lam_a = float(conductivity_a)
+    lam_b = lam_a if conductivity_b is None else float(conductivity_b)
+    if not (lam_a > 0 and lam_b > 0):
+        raise BoundaryConditionError("the grains' conductivities must be > 0 (W/(m K))")
+    pairs, A, da, db, area = plane_contact_geometry(centres_a, centres_b, origin, normal, u_axis, extent_u, extent_v,
+                                                     samples, inside)
+    return pairs, A / (da / lam_a + R + db / lam_b), area
 
 
 def mikic_resistance(pressure, roughness: float, slope: float, hardness: float, conductivity: float):

@@ -9,7 +9,10 @@ volumes): a rigid motion changes none of them, so a grain at any pose reuses its
 Where two grains are (their members' spheres overlap: the DEM presses them together), the
 contact is taken as flat: the plane normal to the two solids' surfaces there (their signed
 distances' gradients, each shape evaluated in its grain's frame) through the middle of their
-overlap, and its patch is the part of that plane inside both solids. The grains' elements are joined across it
+overlap, and its patch is the part of that plane inside both solids, or, when the spheres touch
+while the surfaces are still apart (the spheres' tops under the faces), within half the
+surfaces' largest distance at the spheres' contacts of both: the surfaces touch where they are
+at least as close as where the DEM's spheres do. The grains' elements are joined across it
 by :func:`~yade_electro.network.grain_contact.plane_contact_links`. :func:`grain_network`
 assembles the network of a set of grains at their poses (edges, conductances, capacities) for
 :class:`~yade_electro.network.transient.HeatSolver`.
@@ -24,9 +27,10 @@ from typing import Callable, Sequence, Union
 import numpy as np
 
 from ..core.errors import BoundaryConditionError
-from .grain_contact import plane_contact_links
+from ..geometry.rigid import rigid_pose
+from .grain_contact import contact_resistance_value, plane_contact_geometry
 
-__all__ = ["GrainTemplate", "rigid_pose", "grain_contact", "grain_network"]
+__all__ = ["GrainTemplate", "rigid_pose", "grain_contact_geometry", "grain_contact", "grain_network"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,39 +55,35 @@ class GrainTemplate:
         return self.centres @ np.asarray(rotation, float).T + np.asarray(translation, float)
 
 
-def rigid_pose(reference, current):
-    """(R, t) of the rigid motion ``current ~ reference @ R.T + t`` (least squares, Kabsch)."""
-    P, Q = np.asarray(reference, float), np.asarray(current, float)
-    pc, qc = P.mean(axis=0), Q.mean(axis=0)
-    U, _, Vt = np.linalg.svd((P - pc).T @ (Q - qc))
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(Vt.T @ U.T))])
-    R = Vt.T @ D @ U.T
-    return R, qc - pc @ R.T
-
-
-def _inside(template: GrainTemplate, R, t):
+def _inside(template: GrainTemplate, R, t, within: float = 0.0):
+    """``f(points) -> mask``: the points inside the posed grain's solid, or within ``within`` [m] of it."""
     def f(x):
-        return np.asarray(template.shape.sdf((np.asarray(x, float) - t) @ R), float) <= 0.0
+        return np.asarray(template.shape.sdf((np.asarray(x, float) - t) @ R), float) <= within
     return f
 
 
-def grain_contact(a: GrainTemplate, pose_a, b: GrainTemplate, pose_b, resistance, conductivity,
-                  samples: int = 40_000):
-    """The links between grains a and b at their poses ``(R, t)``: (pairs (k, 2) of element
-    indices (of a, of b), conductances [W/K], the patch area [m^2]); empty when no member
-    spheres of the two overlap. ``resistance``: R_c [m^2 K/W], or ``f(pressure) -> R_c`` given
-    the mean pressure 0 (a caller with forces passes a number)."""
+_NO_CONTACT = (np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0), 0.0)
+
+
+def grain_contact_geometry(a: GrainTemplate, pose_a, b: GrainTemplate, pose_b, samples: int = 40_000):
+    """The contact of grains a and b at their poses ``(R, t)`` as geometry: (pairs (k, 2) of
+    element indices (of a, of b), their shared face areas ``A_ij`` [m^2], the elements'
+    distances to the contact plane ``d_i``, ``d_j`` [m], the patch area [m^2]); empty when no
+    member spheres of the two overlap. Worked in a's frame (b at its pose relative to a), so
+    that it depends on the relative pose only: a rigid motion of the pair changes nothing."""
     (Ra, ta), (Rb, tb) = pose_a, pose_b
-    ca, cb = a.placed(Ra, ta), b.placed(Rb, tb)
+    Ra, Rb = np.asarray(Ra, float), np.asarray(Rb, float)
+    Rb, tb = Ra.T @ Rb, (np.asarray(tb, float) - np.asarray(ta, float)) @ Ra     # b in a's frame
+    Ra, ta = np.eye(3), np.zeros(3)
+    ca, cb = a.centres, b.placed(Rb, tb)
     from scipy.spatial import cKDTree
     lists = cKDTree(cb).query_ball_point(ca, float(a.radii.max() + b.radii.max()))
     ia = np.repeat(np.arange(len(lists)), [len(x) for x in lists])
     ib = np.fromiter((j for x in lists for j in x), dtype=np.int64, count=ia.size)
     d = np.linalg.norm(cb[ib] - ca[ia], axis=1) if ia.size else np.zeros(0)
     over = d < a.radii[ia] + b.radii[ib]
-    empty = (np.zeros((0, 2), np.int64), np.zeros(0), 0.0)
     if not np.any(over):
-        return empty
+        return _NO_CONTACT
     ia, ib, d = ia[over], ib[over], d[over]
     u = (cb[ib] - ca[ia]) / d[:, None]
     # the lens of each pair lies where its two spheres' surfaces cross: its centre on the line
@@ -92,17 +92,24 @@ def grain_contact(a: GrainTemplate, pose_a, b: GrainTemplate, pose_b, resistance
     # the plane: normal to the solids' surfaces there (a's outward normal, b's inward), through
     # the middle of their overlap (where both signed distances are equal)
     for _ in range(3):
-        ga = Ra @ a.shape.gradient(((origin - ta) @ Ra)[None])[0]
+        ga = a.shape.gradient(origin[None])[0]
         gb = Rb @ b.shape.gradient(((origin - tb) @ Rb)[None])[0]
         normal = ga - gb
         normal = normal / np.linalg.norm(normal) if np.linalg.norm(normal) > 0 else u.mean(axis=0)
-        sa = float(a.shape.sdf(((origin - ta) @ Ra)[None])[0])
+        sa = float(a.shape.sdf(origin[None])[0])
         sb = float(b.shape.sdf(((origin - tb) @ Rb)[None])[0])
         origin = origin + 0.5 * (sb - sa) * normal
     axis = np.eye(3)[int(np.argmin(np.abs(normal)))]
     u_axis = np.cross(normal, axis)
     v_axis = np.cross(normal, u_axis)
-    ina, inb = _inside(a, Ra, ta), _inside(b, Rb, tb)
+    # where the DEM's spheres touch, the two surfaces may still be apart (the spheres' tops lie
+    # under the faces): the surfaces are in contact where they are at least as close as at the
+    # farthest apart of the spheres' contacts (their lenses' centres); overlapping solids: where
+    # the plane is inside both
+    lens = ca[ia] + x[:, None] * u
+    apart = float(np.max(a.shape.sdf(lens) + b.shape.sdf((lens - tb) @ Rb)))
+    within = 0.5 * max(apart, 0.0) + 1e-9 * float(a.radii.mean() + b.radii.mean())
+    ina, inb = _inside(a, Ra, ta, within), _inside(b, Rb, tb, within)
     # the patch: the plane's points inside both solids; found on a coarse grid over the grains'
     # reach, then sampled finely over its bounding rectangle
     half = float(max(np.max(np.linalg.norm(ca - origin, axis=1)), np.max(np.linalg.norm(cb - origin, axis=1))))
@@ -112,16 +119,30 @@ def grain_contact(a: GrainTemplate, pose_a, b: GrainTemplate, pose_b, resistance
     grid = origin + U.reshape(-1, 1) * u_axis + V.reshape(-1, 1) * v_axis
     hit = ina(grid) & inb(grid)
     if not np.any(hit):
-        return empty
+        return _NO_CONTACT
     step = 2 * half / k
     ext_u = (float(U.ravel()[hit].min()) - step, float(U.ravel()[hit].max()) + step)
     ext_v = (float(V.ravel()[hit].min()) - step, float(V.ravel()[hit].max()) + step)
-    Rc = resistance(0.0) if callable(resistance) else resistance
-    pairs, G, area = plane_contact_links(ca, cb, origin, normal, u_axis, ext_u, ext_v, Rc, conductivity,
-                                         samples=samples, inside=lambda p: ina(p) & inb(p))
+    pairs, A, da, db, area = plane_contact_geometry(ca, cb, origin, normal, u_axis, ext_u, ext_v, samples=samples,
+                                                    inside=lambda p: ina(p) & inb(p))
     if area <= 0.0:
-        return empty
-    return pairs, G, area
+        return _NO_CONTACT
+    return pairs, A, da, db, area
+
+
+def grain_contact(a: GrainTemplate, pose_a, b: GrainTemplate, pose_b, resistance, conductivity,
+                  samples: int = 40_000):
+    """The links between grains a and b at their poses ``(R, t)``: (pairs (k, 2) of element
+    indices (of a, of b), conductances ``A_ij / (d_i / k + R_c + d_j / k)`` [W/K], the patch
+    area [m^2]); empty when no member spheres of the two overlap
+    (:func:`grain_contact_geometry`). ``resistance``: R_c [m^2 K/W], or ``f(pressure) -> R_c``
+    given the mean pressure 0 (a caller with forces passes a number)."""
+    pairs, A, da, db, area = grain_contact_geometry(a, pose_a, b, pose_b, samples)
+    if not pairs.size:
+        return pairs, A, area
+    Rc = contact_resistance_value(resistance(0.0) if callable(resistance) else resistance)
+    lam = float(conductivity)
+    return pairs, A / ((da + db) / lam + Rc), area
 
 
 def grain_network(grains: Sequence, poses: Sequence, conductivity: float, rho_c: float,

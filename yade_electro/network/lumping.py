@@ -29,7 +29,7 @@ import numpy as np
 from ..core.errors import ThermalError
 from .transient import HeatSolver
 
-__all__ = ["Lumping", "LumpedHeatSolver", "member_volumes", "lens_volume"]
+__all__ = ["Lumping", "LumpedHeatSolver", "member_volumes", "lens_volume", "member_bonds", "MemberLabels"]
 
 
 def lens_volume(r1, r2, d) -> np.ndarray:
@@ -67,6 +67,50 @@ def member_volumes(pos, radius, labels) -> np.ndarray:
     i, j = i[same], j[same]
     half = 0.5 * lens_volume(r[i], r[j], np.linalg.norm(pos[i] - pos[j], axis=1))
     return v - np.bincount(i, half, v.size) - np.bincount(j, half, v.size)
+
+
+def member_bonds(pos, radius, labels, factor: float = 1.0) -> np.ndarray:
+    """Pairs (k, 2) of spheres of one clump (``labels``, -1 for none) whose centres are closer
+    than ``factor`` times their radii's sum: the bonds of a clump's member geometry in a bonded
+    solid (YADE makes no interaction between members of one clump)."""
+    pos, r = np.asarray(pos, float).reshape(-1, 3), np.asarray(radius, float)
+    lab = np.asarray(labels, np.int64)
+    members = np.flatnonzero(lab >= 0)
+    if members.size < 2:
+        return np.zeros((0, 2), np.int64)
+    from scipy.spatial import cKDTree
+    pairs = cKDTree(pos[members]).query_pairs(2.0 * factor * float(r[members].max()), output_type="ndarray")
+    i, j = members[pairs[:, 0]], members[pairs[:, 1]]
+    keep = (lab[i] == lab[j]) & (np.linalg.norm(pos[i] - pos[j], axis=1) < factor * (r[i] + r[j]))
+    return np.column_stack([i[keep], j[keep]]).astype(np.int64)
+
+
+class MemberLabels:
+    """The clump of each sphere, by body id, as at a reader's last full read."""
+
+    def __init__(self):
+        self._ids = self._of = np.zeros(0, np.int64)       # body ids (sorted) -> clump ids
+
+    def update(self, ids, clump) -> None:
+        """Keep ``clump`` (the clump body id of each sphere of body ids ``ids``, -1: none)."""
+        ids = np.asarray(ids, np.int64)
+        order = np.argsort(ids)
+        self._ids, self._of = ids[order], np.asarray(clump, np.int64)[order]
+
+    @property
+    def any(self) -> bool:
+        """True when some sphere is a clump's member."""
+        return bool(np.any(self._of >= 0))
+
+    def of(self, ids) -> np.ndarray:
+        """The clump body id of each sphere of body ids ``ids`` (-1: not in a clump)."""
+        ids = np.asarray(ids, np.int64)
+        out = np.full(ids.shape, -1, np.int64)
+        if self._ids.size:
+            at = np.minimum(np.searchsorted(self._ids, ids), self._ids.size - 1)
+            found = self._ids[at] == ids
+            out[found] = self._of[at[found]]
+        return out
 
 
 @dataclass(frozen=True, eq=False)

@@ -86,6 +86,9 @@ class ResolvedConditions:
         Robin ``k A`` and ``k A u_ambient``, 0 on fixed nodes.
     nodes_of : dict
         name -> node indices of every condition.
+    terms : dict
+        name -> (node indices, per-node values) of each injection (its rates) and Robin
+        condition (its ``k A``), 0 on fixed nodes: what each one adds.
     """
 
     fixed_nodes: dict
@@ -95,6 +98,7 @@ class ResolvedConditions:
     h_area: np.ndarray
     h_area_t_inf: np.ndarray
     nodes_of: dict
+    terms: dict = None
 
 
 def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactGraph] = None,
@@ -151,7 +155,9 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
     is_fixed = owner >= 0
     is_fixed.setflags(write=False)
     q = np.zeros(n)
+    terms = {}
     for b in injections:
+        q_before = q.copy()
         nd = nodes(b)
         rate, density = b.field("rate"), b.field("density")
         if b.name in area_of:
@@ -173,6 +179,7 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
             np.add.at(q, nd, rate * share)
         else:
             np.add.at(q, nd, density * resolve_area(b, nd, n, default_area))
+        terms[b.name] = (np.unique(nd), None, q - q_before)
     if power is not None:
         pw = np.asarray(power, dtype=float)
         if pw.shape != (n,) or not np.all(np.isfinite(pw)):
@@ -185,10 +192,16 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
                                        else resolve_area(b, nd, n, default_area))
         np.add.at(hA, nd, ha)
         np.add.at(hAT, nd, ha * b.field("ambient"))
+        terms[b.name] = (nd, ha, None)
     hA[is_fixed] = 0.0
     hAT[is_fixed] = 0.0
     q[is_fixed] = 0.0
     every = {**fixed_nodes, **{k: v[0] for k, v in links.items()},
              **{b.name: nodes(b) for b in injections + robins}}
+    for name, (nd, ha, added) in list(terms.items()):     # what fixed nodes do not receive
+        if ha is not None:
+            terms[name] = (nd, np.where(is_fixed[nd], 0.0, ha))
+        else:
+            terms[name] = (nd, np.where(is_fixed[nd], 0.0, added[nd]))
     return ResolvedConditions(fixed_nodes=fixed_nodes, links=links, fixed=is_fixed, power=q, h_area=hA,
-                              h_area_t_inf=hAT, nodes_of=every)
+                              h_area_t_inf=hAT, nodes_of=every, terms=terms)

@@ -38,12 +38,11 @@ from ..core.materials import positive_property
 from ..laws.transmission import exposed_area
 from ..solvers.cg import CGSolver
 from ..solvers.base import DirectSolver
-from ..solvers.registry import make_solver
 from .condensation import ReducedSystem
 from .boundary import boundary_value
 from .resolution import resolve_conditions
-from .floating import floating_parts, solve_with_floating
-from .records import HeatStep, SteadyHeat, ThermalState, read_only_copy as _ro
+from .records import HeatStep, ThermalState, read_only_copy as _ro
+from .steady import SteadyHeatSolve
 from .structure import NetworkStructure, Words
 from .theta import theta_of
 
@@ -61,7 +60,7 @@ log = logging.getLogger(__name__)
 # ---------------------------------------------------------------------------------------
 # the integrator
 # ---------------------------------------------------------------------------------------
-class HeatSolver(NetworkStructure):
+class HeatSolver(NetworkStructure, SteadyHeatSolve):
     """Lumped heat conduction on a network, advanced step by step with the theta method.
 
     The structure (the fixed-temperature sets condensed out, the sparsity pattern, the linear
@@ -138,6 +137,9 @@ class HeatSolver(NetworkStructure):
             raise ValueError(f"safety must be in (0, 1], got {safety}")
         self.subcycle, self.safety, self.max_substeps = bool(subcycle), float(safety), int(max_substeps)
         self.graph = graph
+        #: what the floating messages advise for elements joined to nothing (an engine says how
+        #: its reader leaves them out)
+        self.alone_remedy = "leave them out of the model"
         default_area = area if area is not None else (exposed_area(graph) if graph is not None else None)
         if default_area is not None:
             default_area = np.asarray(default_area, dtype=float)
@@ -153,6 +155,7 @@ class HeatSolver(NetworkStructure):
         self._fixed_nodes, self._links, self.fixed = r.fixed_nodes, r.links, r.fixed
         self._fixed_value = {b.name: float(b.field("value")) for b in self.fixed_bcs}
         self._conv_hA, self._conv_hAT = r.h_area, r.h_area_t_inf
+        self._terms = r.terms
         self.flux_power = _ro(r.power)
         self._refresh_links()
         self.nodes_of = r.nodes_of
@@ -281,6 +284,29 @@ class HeatSolver(NetworkStructure):
         self._link_G, self._link_GT = G, GT
         self.h_area = _ro(self._conv_hA + G)
         self._hAT = self._conv_hAT + GT
+
+    def boundary_flows(self, temperature=None) -> dict:
+        """Heat flow [W] the network receives through each boundary condition at
+        ``temperature`` (default the current one), by name: a fixed temperature (from its held
+        elements into the rest, or through its links), a convection ``sum h A (T_inf - T)``, an
+        imposed flux or source (its rate); negative when heat leaves."""
+        T = self._T if temperature is None else np.asarray(temperature, dtype=float)
+        out = {}
+        names = [b.name for b in self.fixed_bcs if b.name in self._fixed_nodes]
+        if names and self._d.size:
+            flux = self.system.group_flux(T[self._u], self._fixed_group_values())
+            out.update(zip(names, (float(f) for f in flux)))
+        out.update(self.link_flows(T))
+        for b in self.conditions:
+            term = self._terms.get(b.name)
+            if term is None:
+                continue
+            nd, values = term
+            if b.ROLE == "robin":
+                out[b.name] = float(np.sum(values * (float(b.field("ambient")) - T[nd])))
+            else:
+                out[b.name] = float(np.sum(values))
+        return out
 
     def _fixed_group_values(self):
         return np.array([self._fixed_value[b.name] for b in self.fixed_bcs if b.name in self._fixed_nodes], dtype=float)
@@ -489,79 +515,3 @@ class HeatSolver(NetworkStructure):
         for k, v in step.info.get("link_energy", {}).items():
             self.link_energy[k] = self.link_energy.get(k, 0.0) + v
         return step
-
-    # -- steady state ------------------------------------------------------------------------
-    def _floating_unknowns(self, heat_in):
-        """(labels, floating mask) of the unknowns that reach no fixed temperature, no link and
-        no convection, by the policy of :mod:`.floating` (None when every part is anchored)."""
-        anchored = self.h_area[self._u] > 0
-        if self._Mud is not None and self._Mud.shape[1]:
-            anchored = anchored | (np.asarray(abs(self._Mud).sum(axis=1)).ravel() > 0)
-        return floating_parts(self._Muu, anchored, heat_in, reached="fixed temperature and no convection",
-                              kept="their mean temperature (their heat)", inflow_name="heat (sources or fluxes)",
-                              remedy="Add a FixedTemperature or a Convection there, or integrate in time (advance)",
-                              error=ThermalError, stacklevel=5)
-
-    def steady(self, sources=None, apply: bool = True, rtol: float = 1e-12) -> SteadyHeat:
-        """The steady temperatures ``M T = s`` with the given ``sources`` [W per node] (plus the
-        fluxes, heat sources, convection and fixed temperatures of this solver); they replace
-        the current temperatures when ``apply`` (the clock does not move). A part of the network
-        that reaches no fixed temperature and no convection keeps its mean temperature when no
-        heat goes into it (a warning), and raises ThermalError when some does: the policy of
-        :mod:`yade_electro.network.floating`.
-
-        The linear solver is ``'auto'`` (:func:`yade_electro.solvers.registry.auto_solver_name`: the
-        deflated CG from 80 unknowns on), kept across calls, to ``rtol`` relative residual."""
-        n = self.n
-        src = np.zeros(n) if sources is None else np.asarray(sources, dtype=float)
-        if src.shape != (n,) or not np.all(np.isfinite(src)):
-            raise ThermalError(f"sources must be a finite ({n},) array (W per node)")
-        u = self._u
-        parts = self._floating_unknowns(src[u] + self.flux_power[u])
-        Tg = self._fixed_group_values()
-        rhs = src[u] + self.flux_power[u] + self._hAT[u]
-        if Tg.size:
-            rhs = rhs - self._Mud @ Tg
-        T = self._T.copy()
-        info = {"iterations": 0, "residual": 0.0}
-        if parts is not None:
-            try:
-                T[u], info = solve_with_floating(self._Muu, rhs, T[u], self._Cu, parts, rtol)
-            except (SolverError, RuntimeError, ArithmeticError) as exc:
-                raise ThermalError(f"the steady heat solve failed ({exc}); the temperatures are unchanged") from exc
-        elif u.size:
-            if getattr(self, "_steady_solver", None) is None or self._steady_key != id(self.system):
-                self._steady_solver = make_solver("auto", n_unknowns=u.size, rtol=rtol)
-                if self.coords is not None:
-                    self._steady_solver.set_geometry(self.coords[u], self._mean_length(self.edges))
-                self._steady_key = id(self.system)
-                self._steady_A = None
-            if self._steady_A is None:
-                self._steady_A = self._Muu.copy()
-            else:
-                self._steady_A.data[:] = self._Muu.data
-                self._steady_solver.update(self._steady_A)
-            try:
-                Tu, info = self._steady_solver.solve(self._steady_A, rhs, x0=T[u])
-            except (SolverError, RuntimeError, ArithmeticError) as exc:
-                raise ThermalError(f"the steady heat solve failed ({exc}); the temperatures are unchanged") from exc
-            if not np.all(np.isfinite(Tu)):
-                raise ThermalError("the steady heat solve gave non-finite temperatures; the temperatures are "
-                                   "unchanged (check the sources and conductances)")
-            T[u] = Tu
-        Tu = T[u]
-        boundary = float(np.sum(self.system.group_flux(Tu, Tg))) if self._d.size else 0.0
-        boundary += float(np.sum(self._link_GT[u] - self._link_G[u] * Tu))
-        mask = np.zeros(n, bool)
-        if parts is not None:
-            mask[u[parts[1]]] = True
-        mask.setflags(write=False)
-        out = SteadyHeat(temperature=_ro(T), source_power=float(np.sum(src[u])),
-                         flux_power=float(np.sum(self.flux_power[u])),
-                         convection_power=float(np.sum(self._conv_hAT[u] - self._conv_hA[u] * Tu)),
-                         boundary_power=boundary, iterations=int(info.get("iterations", 0)),
-                         residual=float(info.get("residual", 0.0)), floating=mask)
-        if apply:
-            self._T = T
-            self._dT_prev = None
-        return out

@@ -19,7 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.shapes import Shape, as_shape, container_volume
+from ..geometry.shapes import Shape, as_shape
+from ..geometry.volumes import container_volume
 from .cache import cache_key, cache_path, load_cached, store
 from .jamming import Relaxer, jam, max_overlap, shrink_to_remove_overlaps
 from .radii import mean_radius_for_count, uniform_radii

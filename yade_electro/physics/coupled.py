@@ -37,13 +37,13 @@ from typing import Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..laws.factors import FactorNetwork
+from ..laws.factor_network import FactorNetwork
 from ..laws.law import Law
 from .electrical import ElectricalModel
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..core.graph import ContactGraph
 from ..core.history import History
-from ..core.materials import Material, real_number, thermal_conductance_of
+from ..core.materials import Material, in_series, real_number, thermal_conductance_of
 from ..core.selection import Membership
 from ..geometry.boundary import BoundaryOfGraph, SurfaceMembership
 from ..network.boundary import FixedValue
@@ -51,9 +51,7 @@ from ..network.lumping import LumpedHeatSolver, Lumping
 from ..network.transient import HeatSolver
 from .thermal import (diffusion_time_step, heat_capacity, heat_material, source_power, split_heat_boundaries,
                       surface_conditions)
-
 from .walls import WallContacts
-
 from .integrator import Integrator
 
 __all__ = ["ElectroThermalModel"]
@@ -175,6 +173,7 @@ class ElectroThermalModel:
         self.history = History(history) if isinstance(history, str) else history
 
         self.heat: Optional[HeatSolver] = None
+        self.alone_remedy = "leave them out of the model"   # the floating messages' advice for lone elements
         self.n_potential_solves = 0
         self.n_rebuilds = 0
         self._rho_solved = None     # per-node resistivity of the last potential solve
@@ -226,7 +225,9 @@ class ElectroThermalModel:
 
     def _thermal_conductance(self, graph):
         lam = self.material.conductivity
-        return thermal_conductance_of(self.network.factor, lam, self.network.edges)
+        G = thermal_conductance_of(self.network.factor, lam, self.network.edges)
+        series = getattr(self.network.law, "thermal_series", None)     # a contact resistance [K/W] (grains)
+        return G if series is None else in_series(G, series(graph, self.network.edges))
 
     def prepare(self, graph: ContactGraph):
         """Bring both models to ``graph`` (see the module doc). Heat that the change of the
@@ -338,6 +339,7 @@ class ElectroThermalModel:
                            time=time, energy=energy, graph=graph, area=area, nodes_of=nodes_of, area_of=area_of,
                            link_of=link_of, power=self._source_power(graph), coords=graph.pos, **self.heat_options)
         self._ids = graph.ids.copy()
+        self.heat.alone_remedy = self.alone_remedy          # (on a lumped solver's wrapper: unused there)
         self._rho_solved = None
         self.n_rebuilds += 1
         log.debug("electro-thermal model rebuilt on a graph of %d nodes, %d edges (dt_crit %.3g s)",
@@ -554,7 +556,8 @@ class ElectroThermalModel:
         fixed-temperature elements, the ambient and imposed fluxes: negative when it leaves),
         particle_heat (brought by elements added, taken by elements erased or resized, or
         set by :meth:`set_temperatures`);
-        then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves.
+        then T_mean (capacity-weighted), T_max, T_min, n_substeps, n_potential_solves, and
+        ``heat_flow:<name>`` [W] through each boundary at the row's temperatures.
         Balance: heat_content change = joule_energy - absorbed_heat + boundary_heat +
         convection_heat + flux_heat + particle_heat."""
         heat = self.heat
@@ -584,6 +587,7 @@ class ElectroThermalModel:
             "n_substeps": step.n_substeps if step is not None else 0,
             "n_potential_solves": self.n_potential_solves,
         })
+        row.update({f"heat_flow:{k}": v for k, v in heat.boundary_flows().items()})
         if self.walls:
             flows = heat.link_flows()
             for w in self.walls:

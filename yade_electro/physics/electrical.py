@@ -27,7 +27,8 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
-from ..laws.factors import ConductanceLaw, FactorNetwork
+from ..laws.factors import ConductanceLaw
+from ..laws.factor_network import FactorNetwork
 from ..laws.law import Law
 from ..core.errors import BoundaryConditionError
 from ..core.graph import ContactGraph
@@ -355,6 +356,7 @@ class ElectricalModel:
             else:
                 nodes = self.memberships[s.name].nodes(graph)
                 electrodes.append(Electrode(s.name, nodes, potential=s.potential, current=s.current))
+        self._check_apart(electrodes, graph)
         self._surface_edges = np.concatenate(surf_edges) if surf_edges else np.zeros((0, 2), dtype=np.int64)
         self._surface_factor = np.concatenate(surf_g) if surf_g else np.zeros(0)
         self._surface_series = np.concatenate(surf_film) if surf_film else np.zeros(0)
@@ -380,6 +382,32 @@ class ElectricalModel:
         self.conductance = c
         self.rebuilds += 1
         self.updates["structure"] += 1
+
+    def _check_apart(self, electrodes, graph) -> None:
+        """BoundaryConditionError when two surface electrodes hold the same boundary faces, or an
+        electrode's elements are also linked to a surface electrode: either shorts the two
+        (overlapping element selections are refused by the conduction problem)."""
+        n = graph.n_nodes
+        contacts = {s.name: self._surface_contact(s, graph) for s in self.specs if s.surface is not None and not s.wall}
+        names = list(contacts)
+        for i, a in enumerate(names):
+            for b in names[i + 1:]:
+                from ..geometry.boundary import shared_faces
+                k = shared_faces(contacts[a], contacts[b])
+                if k:
+                    raise BoundaryConditionError(
+                        f"electrodes {a!r} and {b!r} hold the same {k} boundary face(s) (the same surface given twice, "
+                        "or overlapping surfaces): they would short each other; give each face to one electrode")
+        for e in electrodes:
+            held = np.asarray(e.nodes)
+            held = held[held < n]
+            for name, c in contacts.items():
+                both = np.intersect1d(held, c.nodes)
+                if name != e.name and both.size:
+                    raise BoundaryConditionError(
+                        f"{both.size} element(s) of electrode {e.name!r} are also on surface electrode {name!r} "
+                        "(e.g. a layer of elements and the face they touch): the two would short each other through "
+                        "them; keep the selection off the surface's elements, or give one electrode")
 
     def update(self, graph: ContactGraph) -> Optional[str]:
         """Bring the kept problem to ``graph``; returns what changed: None, 'resistivity',

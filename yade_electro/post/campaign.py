@@ -64,7 +64,7 @@ def _last_json_object(lines) -> Optional[dict]:
         if line.startswith("{"):
             try:
                 obj = json.loads(line)
-            except ValueError:
+            except (ValueError, RecursionError):        # not JSON, or nested beyond the parser's depth
                 continue
             if isinstance(obj, dict):
                 return obj
@@ -119,12 +119,18 @@ def gather(paths: Iterable[str]) -> List[JobResult]:
     return [read_job_log(p) for p in _expand([paths] if isinstance(paths, str) else paths)]
 
 
-def _flatten(d: dict, prefix: str = "") -> dict:
+#: figures nested deeper than this stay one JSON-text column
+MAX_DEPTH = 8
+
+
+def _flatten(d: dict, prefix: str = "", depth: int = 0) -> dict:
     out = {}
     for k, v in d.items():
         key = f"{prefix}{k}"
-        if isinstance(v, dict):
-            out.update(_flatten(v, key + "."))
+        if isinstance(v, dict) and depth < MAX_DEPTH:
+            out.update(_flatten(v, key + ".", depth + 1))
+        elif isinstance(v, dict):
+            out[key] = json.dumps(v)
         elif isinstance(v, list):
             out[key] = json.dumps(v)
         else:

@@ -22,7 +22,8 @@ from .options import (Electrode, InitialTemperature, Materials, Output, Reader, 
                       walls_from_dict)
 from .registry import ENGINES, attach, get_engine
 from .runtime import import_yade, in_yade
-from .scene import SceneReader, ensure_thermal_state, predicate_selector, write_body_attribute
+from .scene import SceneReader, predicate_selector
+from .writeback import ensure_thermal_state, write_body_attribute
 
 __all__ = [
     # the engines

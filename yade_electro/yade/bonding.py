@@ -231,7 +231,7 @@ def add_bonded_packing(packing, material=None, detection_factor=DEFAULT_DETECTIO
         from .persistence import add_container
         try:
             add_container(O, shape, ids)
-        except Exception as exc:        # a shape that cannot be pickled: the engines then need container=
+        except Exception as exc:        # a shape that is not data (a function inside): the engines then need container=
             log.warning("add_bonded_packing: the packing's container cannot be kept with the scene (%s); give "
                         "container= to the engines", exc)
     return list(ids)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..network.lumping import member_volumes
-from .scene import TemperatureWriter
+from .writeback import TemperatureWriter
 
 __all__ = ["clump_volume_fraction", "ClumpTemperatures"]
 
@@ -30,7 +30,7 @@ def clump_volume_fraction(reader):
 
 class ClumpTemperatures:
     """Writes on each clump body (``b.state.temp``) the capacity-weighted mean temperature [K]
-    of its members, through a :class:`~yade_electro.yade.scene.TemperatureWriter` whose kept
+    of its members, through a :class:`~yade_electro.yade.writeback.TemperatureWriter` whose kept
     handles are the clump bodies of the reader's last full read (taken again only when the
     element set changed)."""
 

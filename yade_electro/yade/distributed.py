@@ -39,7 +39,7 @@ from ..physics.distributed import (DISTRIBUTED_LAWS, REGION_LAWS, DistributedEle
 from ..physics.shares import carve_region_share, carve_share
 from ..solvers.partitioned import mpi_comm
 from .runtime import in_mpy_subdomain, mpy_subdomain
-from .scene import ensure_thermal_state, write_body_attribute
+from .writeback import ensure_thermal_state, write_body_attribute
 
 __all__ = ["world_size", "world_rank", "distributed_requested", "distributed_model", "DistributedCalls", "refuse_clumps",
            "PETSC_SOLVERS", "Slabs", "slab_region", "chosen_ids"]

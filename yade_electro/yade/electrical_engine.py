@@ -41,7 +41,7 @@ from ..geometry.shapes import Shape, as_shape
 from . import persistence
 from . import registry
 from .granular import check_wall_bodies
-from .scene import write_body_attribute
+from .writeback import write_body_attribute
 
 from .distributed import DistributedCalls, chosen_ids, distributed_model
 from .engine_base import EngineBase, electrode_walls, keyword_only, material_table
@@ -49,6 +49,18 @@ from .options import Electrode, Output, Reader, electrical_settings
 __all__ = ["ElectricalEngine"]
 
 log = logging.getLogger(__name__)
+
+
+def check_law_clumps(law, clumps):
+    """ValueError when the law (a name, or None) reads clumps in a mode the reader is not given
+    (the 'grains' law: every element of a grain, ``clumps='resolved'``)."""
+    if law is None or not isinstance(law, str) or law == "auto":
+        return
+    from ..laws.factors import law_attribute
+    needed = law_attribute(law, "clumps")
+    if needed is not None and clumps != needed:
+        raise ValueError(f"law {law!r} reads each grain's elements: give Reader(bonds='contacts', clumps={needed!r}) "
+                         f"(got clumps={clumps!r})")
 
 
 @registry.engine_type
@@ -104,11 +116,12 @@ class ElectricalEngine(EngineBase):
                  bonds="cohesive", mask=None, geometry_every: int = 10, move_tolerance: float = 1e-4,
                  full_read_every: int = 0, bond_check: str = "auto", sweep_calls: int = 8,
                  write_back: Optional[str] = "potential", plot: bool = False, label: Optional[str] = None,
-                 reselect: bool = False, container=None, skin="auto", materials=None, clumps=None, O=None,
-                 _resume=None):
+                 reselect: bool = False, container=None, skin="auto", materials=None, clumps=None, isolated="keep",
+                 O=None, _resume=None):
+        check_law_clumps(law, clumps)
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
-                              skin=skin, walls=electrode_walls(electrodes) or None, clumps=clumps)
+                              skin=skin, walls=electrode_walls(electrodes) or None, clumps=clumps, isolated=isolated)
         self._options_bonds = bonds
         self._electrode_walls = electrode_walls(electrodes)
         self._declared_walls = list(self._electrode_walls)
@@ -144,6 +157,10 @@ class ElectricalEngine(EngineBase):
                              "solid whose bonds do not overlap): use Reader(bonds='contacts') for a granular bed, or a "
                              "solid's law "
                              "('voronoi', 'continuum')")
+        if is_contact_law and law in ("contact", "liggghts", "pipe"):
+            log.info("engine: law %r with the %s contact radius (radius='geometric': the lens where the two "
+                     "spheres' surfaces cross, sqrt(2) times Hertz's for equal spheres; radius='hertz': Hertz's)",
+                     law, law_params.get("radius", "geometric"))
         if law == "voronoi" and container is not None:
             law_params["container"] = law_params.get("container") or container
         if law_params.get("container") is not None and not isinstance(law_params["container"], Shape):
@@ -206,7 +223,7 @@ class ElectricalEngine(EngineBase):
                     move_tolerance=o["move_tolerance"], full_read_every=o["full_read_every"],
                     bond_check=o["bond_check"], sweep_calls=o["sweep_calls"], write_back=self.write_back,
                     plot=self.plot, reselect=o["reselect"], container=self.container, skin=o["skin"], clumps=o["clumps"],
-                    materials=self._materials_config)
+                    isolated=o["isolated"], materials=self._materials_config)
 
     def _save_state(self):
         persistence.save_state(self.O, self.label, {

@@ -13,6 +13,7 @@ import numpy as np
 from ..physics.coupled import ElectroThermalModel
 from ..core.errors import BoundaryConditionError, ThermalError
 from ..core.materials import Material, real_number
+from ..laws.factors import law_attribute
 from ..laws.law import Law
 from ..network.heat_conditions import ThermalWall
 from . import persistence
@@ -20,12 +21,12 @@ from . import registry
 from .runtime import import_yade
 from .clumps import ClumpTemperatures, clump_volume_fraction
 from .granular import check_wall_bodies
-from .scene import TemperatureWriter, write_body_attribute
+from .writeback import TemperatureWriter, write_body_attribute
 
 from .distributed import DistributedCalls, chosen_ids, distributed_model, refuse_clumps
-from .electrical_engine import ElectricalEngine
+from .electrical_engine import ElectricalEngine, check_law_clumps
 from .engine_base import electrode_walls, keyword_only, material_table, synced_property
-from .options import Output, Reader, thermal_settings
+from .options import Output, Reader, absolute_temperature, thermal_settings
 from ..physics.integrator import MODEL_OPTIONS, Integrator
 from .overlap import OverlappedCalls, OverlapWork, available_cores, overlap_competes
 __all__ = ["ElectroThermalEngine"]
@@ -110,9 +111,10 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                  move_tolerance: float = 1e-4, full_read_every: int = 0, bond_check: str = "auto",
                  sweep_calls: int = 8, write_back: Optional[str] = "potential", plot: bool = False,
                  label: Optional[str] = None, reselect: bool = False, container=None, walls=None, skin="auto",
-                 materials=None, overlap=False, clumps=None, O=None, _resume=None):
+                 materials=None, overlap=False, clumps=None, isolated="keep", O=None, _resume=None):
         if not isinstance(overlap, bool):
             raise ValueError(f"overlap must be True or False, got {overlap!r}")
+        check_law_clumps(law, clumps)
         if overlap and (electrodes is not None or bonds != "contacts"):
             raise ValueError("overlap=True is for heat-only engines in the granular mode (no Electrode, "
                              "Reader(bonds='contacts')); leave it False here")
@@ -127,7 +129,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         reader_options = dict(bonds=bonds, mask=mask, geometry_every=geometry_every, move_tolerance=move_tolerance,
                               full_read_every=full_read_every, bond_check=bond_check, sweep_calls=sweep_calls,
                               skin=skin, walls={w.name: ids for w, ids in wall_specs if w.isothermal} or None,
-                              clumps=clumps)
+                              clumps=clumps, isolated=isolated)
         self._electrode_walls = electrode_walls(electrodes)
         clash = set(self._electrode_walls) & {w.name for w, _ in wall_specs}
         if clash:
@@ -180,11 +182,12 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
                              coupled_options=dict(coupled_options or {}), overlap=overlap)
         extra = dict(coupled_options or {})
         volume_fraction = extra.pop("volume_fraction", None)
-        if bonds == "contacts" and "cell_volume" not in extra and volume_fraction is None:
+        law_cells = law_attribute(law or "continuum", "cell_volumes") is not None    # the law makes the capacities
+        if bonds == "contacts" and "cell_volume" not in extra and volume_fraction is None and not law_cells:
             volume_fraction = 1.0                        # a particle is its own volume
             if clumps is not None:                       # a clump's members: their shares of its volume
                 volume_fraction = clump_volume_fraction(self.reader)
-        if bonds == "contacts" and clumps == "lumped":
+        if clumps == "lumped":
             extra.setdefault("lumps", lambda graph: self.reader.clump_labels(graph.ids))
         integrator = Integrator(theta=theta, eta=eta, solver=thermal_solver,
                                 **{k: extra.pop(k) for k in MODEL_OPTIONS if k in extra})
@@ -197,6 +200,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         self._coupled = ElectroThermalModel(self.model, heat_material, temperature, integrator=integrator,
                                            boundaries=conditions + [w for w, _ in wall_specs], law=heat_law,
                                            **extra)
+        if bonds == "cohesive":
+            self._coupled.alone_remedy = ("leave them out with Reader(isolated='leave out'), or erase them "
+                                          "(O.bodies.erase(id))")
         self._last_time = float(self.O.time)
         self._temperature_writer = TemperatureWriter()
         self._clump_writer = ClumpTemperatures()
@@ -329,6 +335,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         t["walls"] = dict(self._walls) or None
         t["skin"] = self._options["skin"]
         t["clumps"] = self._options["clumps"]
+        t["isolated"] = self._options["isolated"]
         t["materials"] = self._materials_config
         saved = []
         for bc in self.coupled.conditions + self.coupled.heat_sources:
@@ -403,6 +410,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         if self._resume is not None:
             for k, v in (self._resume_state.get("fixed_values") or {}).items():
                 self.coupled.heat.set_fixed_temperature(k, v)
+        if self.steady:                         # a steady solve that cannot be: said now, in the script
+            self.coupled.heat.check_steady(self.coupled.sources)      # (the Joule heat of the potential solved)
 
     def _material_base(self):
         t = self._thermal
@@ -413,8 +422,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         self.coupled.set_material(**props)
 
     def set_fixed_temperature(self, name: str, temperature: float):
-        """Change a fixed-temperature boundary condition's value from the next call on."""
-        self.coupled.heat.set_fixed_temperature(name, temperature)
+        """Change a fixed-temperature boundary condition's value [K, > 0] from the next call on."""
+        self.coupled.heat.set_fixed_temperature(name, absolute_temperature(f"set_fixed_temperature({name!r})",
+                                                                           temperature))
 
     @property
     def written_attributes(self) -> tuple:
@@ -423,8 +433,16 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
     # -- stepping ------------------------------------------------------------------------
     def steady_state(self) -> dict:
         """Solve the steady temperatures now (from the script, e.g. before ``O.run``): reads the
-        scene, writes the temperatures (and potentials) back; returns the history row."""
-        return self._guarded(lambda: self._step(steady=True))
+        scene, writes the temperatures (and potentials) back; returns the history row. When it
+        raises and the engine is not in ``O.engines`` (nothing of it runs), the engine is
+        removed (its label, history file and saved configuration freed: make a new one)."""
+        try:
+            return self._guarded(lambda: self._step(steady=True))
+        except Exception as exc:
+            if not self.removed and self.runner not in list(self.O.engines):
+                self.remove()
+                exc.add_note(f"engine {self.label!r} is removed (it was not in O.engines): make a new one")
+            raise
 
     def _step(self, steady=None):
         if self.overlap and steady is None:
@@ -510,7 +528,8 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
     def set_temperatures(self, temperatures: Dict[int, float]):
         """Give chosen spheres a temperature [K] at the next call, before its step:
         ``{body id: K}``, for spheres the engine has or spheres added since (particles
-        poured in hot: they take it instead of ``temperature``). The heat this adds or takes
+        poured in hot: they take it instead of ``temperature``); a clump's id stands for all its
+        members when the reader reads clumps. The heat this adds or takes
         is in the history's ``particle_heat``, so the balance still closes. A scene saved
         before that call (``O.save``) keeps them for the run that loads it. Checked now: an
         id that is not a sphere of this scene (or is masked out), or a temperature that is not
@@ -525,12 +544,18 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
             if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
                 raise ValueError(f"set_temperatures: {k!r} is not a body id")
             b = self.O.bodies[int(k)] if 0 <= int(k) < len(self.O.bodies) else None
-            if b is None or not isinstance(b.shape, Sphere) or b.isClump or b.isClumpMember:
+            clumps = bool(getattr(self.reader, "clumps", False))
+            if b is not None and b.isClump and clumps:        # a clump read member by member: all its members
+                members = sorted(int(m) for m in b.shape.members.keys())
+                checked.update(dict.fromkeys(members, absolute_temperature(f"set_temperatures[{k}] (K)", v)))
+                continue
+            if b is None or not isinstance(b.shape, Sphere) or b.isClump or (b.isClumpMember and not clumps):
                 raise ValueError(f"set_temperatures: body {k!r} is not a sphere of this scene (only spheres carry "
-                                 "temperatures)")
+                                 "temperatures; clumps and their members do when the reader reads clumps, "
+                                 "Reader(bonds='contacts', clumps=...))")
             if mask is not None and not (b.mask & mask):
                 raise ValueError(f"set_temperatures: body {k} is masked out of this engine (mask={mask})")
-            checked[int(k)] = real_number(f"set_temperatures[{k}] (K)", v)
+            checked[int(k)] = absolute_temperature(f"set_temperatures[{k}] (K)", v)
         self._pending_temperatures.update(checked)
         self._save_state()                  # an O.save before the next call keeps them
 

@@ -8,12 +8,12 @@ import functools
 import inspect
 import logging
 import os
-import pickle
 import warnings
 from typing import Dict, Optional
 
 import numpy as np
 
+from ..core import codec
 from ..core.errors import BoundaryConditionError, MaterialError
 from ..geometry.shapes import Shape
 from ..core.history import History
@@ -23,7 +23,8 @@ from . import registry
 from .runtime import MPY_REFUSAL, import_yade, in_mpy_subdomain
 from .distributed import PETSC_SOLVERS, distributed_requested, slab_region, world_rank
 from .granular import GranularReader
-from .scene import SceneReader, check_write_back, predicate_selector
+from .scene import SceneReader, predicate_selector
+from .writeback import check_write_back
 
 __all__ = ["EngineBase", "synced_property", "electrode_walls", "material_table", "is_predicate", "check_period",
            "REMOVED_KEYWORDS", "keyword_only"]
@@ -69,6 +70,7 @@ REMOVED_KEYWORDS = {
     "bond_check": "reader=Reader(bond_check=...)",
     "sweep_calls": "reader=Reader(sweep_calls=...)",
     "skin": "reader=Reader(skin=...)",
+    "isolated": "reader=Reader(isolated=...)",
     "reselect": "reader=Reader(reselect=True)",
     "overlap": "reader=Reader(overlap=True)",
 }
@@ -188,6 +190,7 @@ class EngineBase(registry.RegisteredEngine):
         self.iterPeriod = check_period(iterPeriod)
         opts = dict(reader_options)
         skin, walls, clumps = opts.pop("skin", "auto"), opts.pop("walls", None), opts.pop("clumps", None)
+        isolated = opts.pop("isolated", "keep")
         if opts["bonds"] == "contacts":
             self._reader = GranularReader(self.O, mask=opts["mask"], skin=skin, walls=walls,
                                           periodic=self._heat_only, clumps=clumps is not None)
@@ -196,7 +199,7 @@ class EngineBase(registry.RegisteredEngine):
                 raise BoundaryConditionError("walls (Wall, or Electrode(wall=...)) conduct in the granular mode "
                                              "only (Reader(bonds='contacts')): a bonded solid's boundaries are surfaces "
                                              "(surface=)")
-            self._reader = SceneReader(self.O, **opts)
+            self._reader = SceneReader(self.O, **opts, clumps=clumps is not None, isolated=isolated)
         if history_mode not in ("w", "a", "x"):
             raise ValueError(f"history_mode must be 'w', 'a' or 'x', got {history_mode!r}")
         self.history_path = None if history is None else os.fspath(history)
@@ -260,6 +263,7 @@ class EngineBase(registry.RegisteredEngine):
             if world_rank() != 0:
                 self.history_path = None            # rank 0 writes the history
         else:
+            self._check_bonded(graph)
             self._prepare(graph)                    # selections, structure: their errors here too
         mode = "a" if self._resume is not None else history_mode
         self._history = History(self.history_path, mode)
@@ -270,6 +274,21 @@ class EngineBase(registry.RegisteredEngine):
         registry.ENGINES[self.label] = self
         self._save_config()
         self._save_state()
+
+    def _check_bonded(self, graph):
+        """A bonded solid with no bond at all: refused when something has run (the bonding step was
+        forgotten, the packing is cohesionless); before the first step, said (bonds made by YADE's
+        first steps, ``setCohesionNow``, are read then)."""
+        if self._options.get("bonds") != "cohesive" or graph.n_nodes < 2 or len(graph.edges) or self._resume is not None:
+            return
+        said = (f"engine {self.label!r}: none of the {graph.n_nodes} spheres is bonded to another (a bonded solid, "
+                "Reader(bonds='cohesive'), conducts through its cohesive bonds): run the bonding step first "
+                "(yade_electro.yade.packing.add_bonded_packing, or CohFrictMat with setCohesionNow and one O.step()), "
+                "or use Reader(bonds='contacts') for a cohesionless packing")
+        if int(self.O.iter) > 0 or self.O.interactions.countReal() > 0:
+            raise BoundaryConditionError(said)
+        warnings.warn(said + "; nothing has run yet, so the bonds may still come from the first steps",
+                      stacklevel=4)
 
     @property
     def reader(self):
@@ -287,9 +306,9 @@ class EngineBase(registry.RegisteredEngine):
         saved, missing = {}, []
         for k, v in kwargs.items():
             try:
-                pickle.dumps(v, protocol=4)
+                codec.dumps(v)
                 saved[k] = v
-            except Exception:
+            except TypeError:
                 missing.append(k)
         if missing:
             log.warning("engine %r: %s cannot be saved with the scene; after O.load, attach(%r, %s=...) must give "
@@ -390,6 +409,8 @@ class EngineBase(registry.RegisteredEngine):
         return self._distributed is not None
 
     def _write_row(self, row):
+        if getattr(self._reader, "bonds", None) == "cohesive":    # how soon a bond broken now is seen
+            row["bond_check_calls"] = int(self._reader.bond_check_calls)
         self.history.append(row)
         if self.plot:
             self._plot_row(row)

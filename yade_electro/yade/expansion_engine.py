@@ -238,7 +238,7 @@ class ThermalExpansion(registry.RegisteredEngine):
         spheres = float(np.sum(4.0 / 3.0 * np.pi * r ** 3))
         container = persistence.scene_container(self.O) if solid_volume is None else None
         if container is not None:               # the packing's own container (add_bonded_packing)
-            from ..geometry.shapes import container_volume
+            from ..geometry.volumes import container_volume
             solid_volume = float(container_volume(container)[0])
         if solid_volume is None:
             from scipy.spatial import ConvexHull

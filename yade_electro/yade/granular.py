@@ -45,6 +45,7 @@ from ..geometry.contacts import (WallGeometry, candidate_pairs, facet_vertices, 
                         quaternion_matrices, wall_candidates, wall_overlaps)
 from ..core.errors import BoundaryConditionError, GraphError
 from ..core.graph import ContactGraph
+from ..network.lumping import MemberLabels
 from .runtime import import_yade
 from .scene import bulk_coordinates, probe_replaced, read_spheres, warn_left_out
 
@@ -215,7 +216,7 @@ class GranularReader:
         self.periodic = False
         self.accepts_periodic = bool(periodic)
         self.clumps = bool(clumps)
-        self._clump_ids = self._clump_of = np.zeros(0, np.int64)     # body ids (sorted) -> clump ids
+        self._clumps = MemberLabels()
         #: ``keep(ids, pos, radius) -> mask``: read only the spheres of a region (see
         #: :func:`~yade_electro.yade.scene.read_spheres`); None: all
         self.region = None
@@ -280,18 +281,12 @@ class GranularReader:
     @property
     def has_clumps(self) -> bool:
         """True when the last full read found clump members."""
-        return bool(np.any(self._clump_of >= 0))
+        return self._clumps.any
 
     def clump_labels(self, ids) -> np.ndarray:
         """The clump body id of each sphere of body ids ``ids`` (-1: not in a clump), as at the
         last full read (the element set changes only there)."""
-        ids = np.asarray(ids, np.int64)
-        out = np.full(ids.shape, -1, np.int64)
-        if self._clump_ids.size:
-            at = np.minimum(np.searchsorted(self._clump_ids, ids), self._clump_ids.size - 1)
-            found = self._clump_ids[at] == ids
-            out[found] = self._clump_of[at[found]]
-        return out
+        return self._clumps.of(ids)
 
     def wall_contacts(self, name: str):
         """(nodes, overlaps [m]) of the spheres touching wall ``name`` at the last read."""
@@ -333,8 +328,7 @@ class GranularReader:
         spheres = read_spheres(self.O, self.mask, periodic=self.accepts_periodic, keep=self.region,
                                clumps=self.clumps)
         if spheres.clump is not None:
-            order = np.argsort(spheres.ids)
-            self._clump_ids, self._clump_of = spheres.ids[order], spheres.clump[order]
+            self._clumps.update(spheres.ids, spheres.clump)
         self.periodic = bool(self.O.periodic)
         if self.periodic and self.walls:
             raise GraphError(f"walls ({sorted(self.walls)}) in a periodic cell are not supported: a sphere meets a "

@@ -31,6 +31,8 @@ class HeatEngine(ElectroThermalEngine):
     ------
     BoundaryConditionError
         An ``Electrode`` among the boundaries (use :class:`ElectroThermalEngine`).
+    ValueError
+        ``Output(write_back=...)``: a heat engine writes no potential.
     """
 
     DEFAULT_LABEL = "heat"
@@ -39,6 +41,9 @@ class HeatEngine(ElectroThermalEngine):
     def __init__(self, *, material, boundaries=(), temperature, law="auto", integrator: Integrator = Integrator(),
                  reader: Reader = Reader(), output: Output = Output(), iterPeriod: int = 1,
                  label: Optional[str] = None):
+        if output.write_back not in (None, Output.write_back):
+            raise ValueError(f"HeatEngine writes no potential, so Output(write_back={output.write_back!r}) has nothing "
+                             "to write (the temperatures go to b.state.temp): leave write_back out")
         settings = thermal_settings(material, boundaries, temperature, law, integrator, reader, output, "HeatEngine")
         if settings["electrodes"] is not None:
             raise BoundaryConditionError("HeatEngine conducts heat only: use ElectroThermalEngine for electrodes")

@@ -27,6 +27,7 @@ from __future__ import annotations
 import importlib.abc
 import importlib.machinery
 import os
+import re
 import runpy
 import shutil
 import sys
@@ -127,6 +128,34 @@ def made_log_directories(args) -> list:
     return made
 
 
+_SHELL_SAFE = re.compile(r"^[A-Za-z0-9_./+=:,@%-]+$")
+
+
+def check_batch_words(args) -> None:
+    """Refuse what yade-batch would put unquoted into a job's shell command (it runs jobs with
+    ``os.system``): a script name, or a table's ``!SCRIPT``, ``!EXEC`` or environment cell,
+    with characters the shell reads (spaces, ``; | & $ ` < > ( )``, quotes, newlines).
+    SystemExit naming the word."""
+    positional = [a for a in args if not a.startswith("-")]
+    for a in positional:
+        if a.endswith(".py") and not _SHELL_SAFE.match(a):
+            raise SystemExit(f"yade-electro batch: the script name {a!r} has characters the shell would read "
+                             "(yade-batch runs each job through the shell, unquoted): rename it")
+    for a in positional:
+        if a.endswith(".py") or not os.path.isfile(a):
+            continue
+        rows = [ln.split() for ln in open(a, errors="replace").read().splitlines()
+                if ln.strip() and not ln.lstrip().startswith("#")]
+        if not rows:
+            continue
+        head = rows[0]
+        for n, row in enumerate(rows[1:], start=2):
+            for col, val in zip(head, row):
+                if col.startswith("!") and col not in ("!AFFINITY", "!COUNT") and not _SHELL_SAFE.match(val):
+                    raise SystemExit(f"yade-electro batch: table {a!r}, row {n}, column {col}: {val!r} has characters "
+                                     "the shell would read (yade-batch puts it unquoted into the job's command)")
+
+
 def main(argv=None) -> None:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv[:1] == ["gather"]:
@@ -136,6 +165,7 @@ def main(argv=None) -> None:
         args = argv[1:]
         if not any(a == "--executable" or a.startswith("--executable=") for a in args):
             args = ["--executable", _self_command()] + args
+        check_batch_words(args)
         _disable_batch_http()
         made_log_directories(args)
         path = find_launcher("yade-batch", "YADE_ELECTRO_YADE_BATCH")

@@ -68,11 +68,19 @@ class Reader:
         How bonds that break with no counter change are found: ``'sweep'`` reads
         1/``sweep_calls`` of the bond flags per call, ``'flags'`` all of them every call,
         ``'counters'`` YADE's JCFpm crack counters; ``'auto'`` picks the counters with JCFpm,
-        else the sweep (see :mod:`yade_electro.yade.scene`).
+        else reads at most 2,500 flags a call: all of them up to 2,500 bonds, else a sweep
+        over the calls that needs (see :mod:`yade_electro.yade.scene`). The history rows'
+        ``bond_check_calls`` say within how many calls a break is seen.
     sweep_calls : int
-        Calls over which the sweep reads every bond once (default 8).
+        Calls over which ``'sweep'`` reads every bond once (default 8).
     skin : 'auto' or float
         Granular beds: the Verlet skin in smallest radii (default: adapted to the motion).
+    isolated : {'keep', 'leave out'}
+        Bonded solids: spheres with no bond (a particle the bonding missed, a loose sphere
+        dropped in). ``'keep'`` (default): they are elements that conduct nothing (floating:
+        they keep their heat and carry no current, a warning names them); one lying outside
+        the container is an error naming it. ``'leave out'``: they are not elements (a log
+        warning names them at each full read that leaves some out).
     reselect : bool
         Select element-layer electrodes and conditions again on each new structure, instead
         of keeping them by body id (default False).
@@ -87,8 +95,12 @@ class Reader:
         per clump pair; ``'resolved'``: each member its own temperature, members of one clump
         joined through the lens where they overlap (see
         :mod:`yade_electro.network.lumping`). Currents flow member by member in both. The
-        temperature is written on the members and on the clump body. Bonded solids leave
-        clumps out (a warning).
+        temperature is written on the members and on the clump body. In a bonded solid
+        (``bonds='cohesive'``) the members are elements bonded to their neighbours by YADE's
+        cohesive interactions, and to the members of their own clump where their spheres are
+        closer than 1.04 times their radii's sum (YADE makes no interaction inside a clump;
+        those bonds never break); ``'lumped'`` and ``'resolved'`` as above, and without
+        ``clumps`` a bonded solid leaves clumps out (a warning).
     """
 
     bonds: str = "cohesive"
@@ -102,6 +114,7 @@ class Reader:
     reselect: bool = False
     overlap: bool = False
     clumps: Optional[str] = None
+    isolated: str = "keep"
 
     def __post_init__(self):
         if self.bonds not in ("cohesive", "contacts"):
@@ -110,19 +123,22 @@ class Reader:
         for name in ("reselect", "overlap"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"Reader {name} must be True or False, got {getattr(self, name)!r}")
+        if self.isolated not in ("keep", "leave out"):
+            raise ValueError(f"Reader isolated must be 'keep' or 'leave out', got {self.isolated!r}")
+        if self.isolated != "keep" and self.bonds != "cohesive":
+            raise ValueError("Reader isolated= is for bonded solids (bonds='cohesive'): in a granular bed a particle "
+                             "touching nothing is an element like the others")
         if self.clumps not in (None, "lumped", "resolved"):
             raise ValueError(f"Reader clumps must be 'lumped' (one temperature per clump) or 'resolved' (one per "
                              f"member), got {self.clumps!r}")
-        if self.clumps is not None and self.bonds != "contacts":
-            raise ValueError("Reader clumps= is for granular beds (bonds='contacts'): a bonded solid's reader leaves "
-                             "clumps out")
 
     def scene_options(self) -> dict:
         """The scene reader's keyword arguments."""
         return dict(bonds=self.bonds, mask=self.mask, geometry_every=self.geometry_every,
                     move_tolerance=self.move_tolerance, full_read_every=self.full_read_every,
                     bond_check=self.bond_check, sweep_calls=self.sweep_calls, skin=self.skin,
-                    clumps=self.clumps if self.clumps is not None or self.bonds != "contacts" else "lumped")
+                    clumps=self.clumps if self.clumps is not None or self.bonds != "contacts" else "lumped",
+                    isolated=self.isolated)
 
 
 @dataclass(frozen=True)
@@ -371,6 +387,30 @@ def electrical_settings(material, boundaries, law, reader, output) -> dict:
 HEAT_ROLES = ("fixed", "injection", "robin", "source")
 
 
+def absolute_temperature(what: str, value) -> float:
+    """``value`` as a float, refused (ValueError) unless finite and > 0: the engines work in
+    kelvin (b.state.temp is YADE's absolute temperature)."""
+    T = real_number(what, value)
+    if not T > 0.0:
+        raise ValueError(f"{what}: {T!r} is not an absolute temperature; the engines work in kelvin, > 0 K (20 degC is "
+                         "293.15 K)")
+    return T
+
+
+def _check_kelvin(engine: str, conditions, walls) -> None:
+    """The temperatures the heat conditions and walls give, each > 0 K (:func:`absolute_temperature`)."""
+    for c in conditions:
+        for role, unit in getattr(c, "UNITS", {}).items():
+            field = getattr(c, "FIELDS", {}).get(role, role)
+            v = getattr(c, field, None)
+            if unit == "K" and v is not None and not callable(v):
+                for x in np.ravel(np.asarray(v, dtype=object)):
+                    absolute_temperature(f"{engine}: {c.KIND} {c.name!r} {field}", x)
+    for w in walls:
+        if w.temperature is not None:
+            absolute_temperature(f"{engine}: Wall {w.name!r} temperature", w.temperature)
+
+
 def thermal_settings(material, boundaries, temperature, law, integrator, reader, output, engine: str) -> dict:
     """The heat engines' internal settings from their option objects."""
     from ..network.boundary import Condition
@@ -397,6 +437,10 @@ def thermal_settings(material, boundaries, temperature, law, integrator, reader,
         raise ValueError(f"{engine}: give the starting temperature= (K), or InitialTemperature(K, by_id={{id: K}})")
     else:
         T, by_id = real_number(f"{engine}: temperature (K)", temperature), None
+    absolute_temperature(f"{engine}: temperature", T)
+    for k, v in (by_id.items() if hasattr(by_id, "items") else ()):     # (not a dict: refused when the engine is built)
+        absolute_temperature(f"{engine}: initial_temperature[{k}] (InitialTemperature by_id)", v)
+    _check_kelvin(engine, groups[Condition], groups[Wall])
     if not isinstance(integrator, Integrator):
         raise TypeError(f"{engine}: integrator= must be an Integrator(...), got {integrator!r}")
     base = Integrator()

@@ -7,8 +7,8 @@ elsewhere, e.g. by YADE's ``pack.randomDensePack``).
 pack.inCylinder(...), n=5000))`` is the two-line recipe of paper 000 section 2.1. This module
 holds no code of its own; it names what the three modules hold.
 """
-from ..geometry.shapes import (Box, Cylinder, Difference, GridShape, Intersection, Shape, Sphere, Union, as_shape,
-                        container_volume)
+from ..geometry.shapes import (Box, Cylinder, Difference, GridShape, Intersection, Shape, Sphere, Union, as_shape)
+from ..geometry.volumes import container_volume
 from ..packing import (DEFAULT_DETECTION_FACTOR, PACKING_VERSION, SpherePacking, bond_pairs, dense_packing,
                        detection_factor_for_coordination, mean_radius_for_count, packing_statistics)
 from .bonding import add_bonded_packing, steel_304L

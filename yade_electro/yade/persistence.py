@@ -6,21 +6,26 @@ with ``overlap=True``):
 
 * ``yade_electro:<label>:config``: everything needed to build the engine again (materials,
   law and its reference geometry, electrode and boundary-condition membership *by body id*,
-  solver, options), pickled and base64-encoded; written when the engine is built;
+  solver, options), as data (:mod:`yade_electro.core.codec`: JSON, arrays in base64, this
+  package's objects by their fields; never pickle, which would run code a crafted scene file
+  holds); written when the engine is built;
 * ``yade_electro:<label>:state``: what changes every call (electrode values, thermal clock,
   energy ledger, fixed temperatures, the iteration and time of the last call, the number of
   history rows), JSON; written at every call (about 30 us);
 * ``yade_electro:<label>:call``: with ``overlap=True``, the input of the call computed on the
-  worker thread and not yet published (pickled, base64), which a loaded scene replays.
+  worker thread and not yet published (the same codec), which a loaded scene replays.
+
+Tags an older version wrote with pickle are not read (a clear error says to build the engine
+again).
 
 Temperatures are in ``b.state.temp`` (YADE's ThermalState), which YADE saves itself.
 """
 from __future__ import annotations
 
-import base64
 import json
-import pickle
 from typing import Optional
+
+from ..core import codec
 
 __all__ = ["PREFIX", "config_key", "state_key", "call_key", "save_config", "load_config", "save_state", "load_state",
            "save_call", "load_call",
@@ -47,21 +52,23 @@ def _tag(O, key: str) -> Optional[str]:
     return tags[key] if key in tags.keys() and tags[key] else None
 
 
-def _pickled(obj) -> str:
-    """``obj`` pickled and base64-encoded (ASCII: a YADE tag survives .xml and binary saves)."""
-    return base64.b64encode(pickle.dumps(obj, protocol=4)).decode("ascii")
-
-
-def _unpickled(text: Optional[str]):
-    return None if text is None else pickle.loads(base64.b64decode(text.encode("ascii")))
+def _read(text: Optional[str], what: str):
+    if text is None:
+        return None
+    try:
+        return codec.loads(text)
+    except ValueError as exc:
+        raise ValueError(f"{what} in this scene cannot be read ({exc}): a scene saved by an older yade-electro "
+                         "(which kept it in pickle, a format that can run code, no longer read) or damaged; build "
+                         "the engine again instead of attaching it") from None
 
 
 def save_config(O, label: str, config: dict) -> None:
-    """Store an engine's configuration in the scene (pickled; raises TypeError with the name
-    of the part that cannot be pickled)."""
+    """Store an engine's configuration in the scene (as data; raises TypeError naming the part
+    that is not data)."""
     try:
-        text = _pickled(config)
-    except Exception as exc:
+        text = codec.dumps(config)
+    except TypeError as exc:
         raise TypeError(f"the configuration of engine {label!r} cannot be saved with the scene ({exc}); "
                         "give selectors, containers and options as plain data or YADE predicates") from None
     _tags(O)[config_key(label)] = text
@@ -69,7 +76,7 @@ def save_config(O, label: str, config: dict) -> None:
 
 def load_config(O, label: str) -> Optional[dict]:
     """The configuration saved under ``label``, or None."""
-    return _unpickled(_tag(O, config_key(label)))
+    return _read(_tag(O, config_key(label)), f"the saved configuration of engine {label!r}")
 
 
 def save_state(O, label: str, state: dict) -> None:
@@ -82,14 +89,14 @@ def call_key(label: str) -> str:
 
 
 def save_call(O, label: str, call) -> None:
-    """Store an overlapped engine's unpublished call (plain data: it is pickled) in the
-    scene: a tag of its own, so the state's JSON stays small."""
-    _tags(O)[call_key(label)] = _pickled(call)
+    """Store an overlapped engine's unpublished call (plain data) in the scene: a tag of its
+    own, so the state's JSON stays small."""
+    _tags(O)[call_key(label)] = codec.dumps(call)
 
 
 def load_call(O, label: str):
     """The unpublished call saved under ``label``, or None."""
-    return _unpickled(_tag(O, call_key(label)))
+    return _read(_tag(O, call_key(label)), f"the unpublished call of engine {label!r}")
 
 
 def load_state(O, label: str) -> Optional[dict]:
@@ -126,10 +133,13 @@ def add_container(O, shape, ids) -> None:
     tags = _tags(O)
     kept = []
     if CONTAINER_KEY in tags.keys() and tags[CONTAINER_KEY]:
-        kept = pickle.loads(base64.b64decode(tags[CONTAINER_KEY].encode("ascii")))
+        try:
+            kept = list(codec.loads(tags[CONTAINER_KEY]))
+        except ValueError:          # an older version's tag: started again
+            kept = []
     ids = list(int(i) for i in ids)
     kept.append((shape, (min(ids), max(ids), len(ids)) if ids else (0, -1, 0)))
-    tags[CONTAINER_KEY] = base64.b64encode(pickle.dumps(kept, protocol=4)).decode("ascii")
+    tags[CONTAINER_KEY] = codec.dumps(kept)
 
 
 def scene_container(O):
@@ -139,7 +149,7 @@ def scene_container(O):
     if CONTAINER_KEY not in tags.keys() or not tags[CONTAINER_KEY]:
         return None
     try:
-        kept = pickle.loads(base64.b64decode(tags[CONTAINER_KEY].encode("ascii")))
-    except Exception:           # a tag this version cannot read: as if there were none
+        kept = codec.loads(tags[CONTAINER_KEY])
+    except ValueError:          # a tag this version cannot read: as if there were none
         return None
     return kept[0][0] if len(kept) == 1 else None

@@ -141,9 +141,17 @@ def check_shared_outputs(engine) -> None:
             raise ValueError(f"engine {other.label!r} already writes the history file {p1!r}; give this engine "
                              "another Output(history=...) path")
         for attr in engine.written_attributes:
-            if attr in other.written_attributes:
-                warnings.warn(f"engines {other.label!r} and {engine.label!r} both write b.{attr} on the bodies: the "
-                              "last one to run wins; give one of them another write_back=", stacklevel=4)
+            if attr not in other.written_attributes:
+                continue
+            if attr == "state.temp":        # YADE's one temperature: only bodies apart (masks) keep both
+                m1, m2 = getattr(engine.reader, "mask", None), getattr(other.reader, "mask", None)
+                if m1 is not None and m2 is not None and not (int(m1) & int(m2)):
+                    continue
+                advice = "give the two engines bodies apart (Reader(mask=...)), or make one engine of both"
+            else:
+                advice = "give one of them another Output(write_back=...)"
+            warnings.warn(f"engines {other.label!r} and {engine.label!r} both write b.{attr} on the bodies: the last "
+                          f"one to run wins; {advice}", stacklevel=4)
 
 
 def attach(label: Optional[str] = None, O=None, **overrides):

@@ -1,5 +1,5 @@
-"""Contact graphs read from a running YADE scene, with cheap change detection, and results
-written back to the bodies.
+"""Contact graphs read from a running YADE scene, with cheap change detection (the results go
+back to the bodies through :mod:`yade_electro.yade.writeback`).
 
 What is read
 ------------
@@ -33,7 +33,12 @@ A CohFrictMat bond that breaks in shear while its spheres stay pressed together 
 counter. ``bond_check`` says how such breaks are found, with a cost of about 0.19 us per
 bond per read of its flag:
 
-* ``'auto'`` (default): ``'counters'`` when the scene has a JCFpm law, else ``'sweep'``;
+* ``'auto'`` (default): ``'counters'`` when the scene has a JCFpm law; else ``'flags'`` up to
+  :data:`FLAG_BUDGET` bonds (2,500: about 0.5 ms a call), so that a break is seen at the next
+  call, and beyond that ``'sweep'`` over the fewest calls that read at most that many flags a
+  call (7 calls for the 5,000-element rod's 16,851 bonds). How many calls a break may take to
+  be seen is :attr:`SceneReader.bond_check_calls`, in each history row as
+  ``bond_check_calls`` (1: at the next call);
 * ``'sweep'``: each call reads the flags of 1/``sweep_calls`` of the bonds, in turn: every
   bond is checked every ``sweep_calls`` calls (default 8: 0.4 ms a call at 5,000
   elements), so such a break is seen within ``sweep_calls`` calls; real interactions are
@@ -54,23 +59,26 @@ from __future__ import annotations
 import array
 import logging
 import operator
-from collections import Counter, deque
-from itertools import repeat
+from collections import Counter
 from typing import List, NamedTuple, Optional
 
 import numpy as np
 
 from ..core.errors import GraphError
 from ..core.graph import ContactGraph
+from ..network.lumping import MemberLabels, member_bonds
+from ..packing.statistics import DEFAULT_DETECTION_FACTOR
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "write_body_attribute", "TemperatureWriter", "ensure_thermal_state", "predicate_selector",
-           "check_write_back", "BOND_CHECKS", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced",
+__all__ = ["SceneReader", "predicate_selector", "BOND_CHECKS", "FLAG_BUDGET", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced",
            "warn_left_out", "PERIODIC_REFUSAL"]
 
 log = logging.getLogger(__name__)
 
 BOND_CHECKS = ("auto", "sweep", "flags", "counters", "count")
+#: 'auto' reads at most this many bond flags a call (0.19 us a flag): all of them up to this
+#: many bonds, else a sweep over the calls that needs
+FLAG_BUDGET = 2_500
 
 
 def _bond_flag(phys):
@@ -205,10 +213,10 @@ def warn_left_out(ignored: Counter, before: Counter) -> None:
     elements), which a bed of clumps would otherwise get silently."""
     n = ignored.get("clump", 0)
     if n > before.get("clump", 0):
-        log.warning("%d clump(s) and clump member(s) are left out: a bonded solid's reader takes plain spheres "
-                    "only, so they carry no heat or current and their contacts do not conduct. Clumps conduct in a "
-                    "granular bed (Reader(bonds='contacts', clumps='lumped' or 'resolved')); here use spheres, or "
-                    "leave the clumps out of the mask on purpose", n)
+        log.warning("%d clump(s) and clump member(s) are left out: this reader takes plain spheres only, so they "
+                    "carry no heat or current and their contacts do not conduct. Read them with "
+                    "Reader(clumps='lumped') (one temperature per clump) or Reader(clumps='resolved') (one per "
+                    "member), or leave the clumps out of the mask on purpose", n)
 
 
 def bulk_coordinates(n_existing: Optional[int] = None) -> np.ndarray:
@@ -280,11 +288,19 @@ class SceneReader:
         How bonds broken with no counter change are found (see module doc).
     sweep_calls : int
         Calls over which ``'sweep'`` reads every bond flag once.
+    clumps : bool
+        Read clump members as elements, members of one clump bonded where their spheres are
+        closer than ``clump_bond_factor`` times their radii's sum (YADE makes no interaction
+        inside a clump; those bonds never break); False: clumps are left out, with a warning.
+    isolated : {'keep', 'leave out'}
+        ``bonds='cohesive'``: spheres with no bond are elements (``'keep'``) or are left out,
+        named in a log warning (``'leave out'``; their body ids in ``left_out``).
     """
 
     def __init__(self, O=None, bonds: str = "cohesive", mask: Optional[int] = None,
                  geometry_every: int = 10, move_tolerance: float = 1e-4, full_read_every: int = 0,
-                 bond_check: str = "auto", sweep_calls: int = 8):
+                 bond_check: str = "auto", sweep_calls: int = 8, clumps: bool = False,
+                 clump_bond_factor: float = DEFAULT_DETECTION_FACTOR, isolated: str = "keep"):
         if bond_check not in BOND_CHECKS:
             raise ValueError(f"bond_check must be one of {', '.join(BOND_CHECKS)}, got {bond_check!r}")
         if bonds not in ("cohesive", "contacts"):
@@ -303,6 +319,13 @@ class SceneReader:
         self.O = O
         self.bonds = bonds
         self.mask = mask
+        self.clumps, self.clump_bond_factor = bool(clumps), float(clump_bond_factor)
+        if isolated not in ("keep", "leave out"):
+            raise ValueError(f"isolated must be 'keep' or 'leave out', got {isolated!r}")
+        self.isolated = isolated
+        #: body ids of the spheres with no bond that the last full read left out (isolated='leave out')
+        self.left_out = np.zeros(0, np.int64)
+        self._clumps = MemberLabels()
         self.geometry_every = int(geometry_every)
         self.move_tolerance = float(move_tolerance)
         self.full_read_every = int(full_read_every)
@@ -357,11 +380,32 @@ class SceneReader:
         return probe_replaced(self.O, self._probe)
 
     @property
+    def has_clumps(self) -> bool:
+        """True when the last full read found clump members."""
+        return self._clumps.any
+
+    def clump_labels(self, ids) -> np.ndarray:
+        """The clump body id of each sphere of body ids ``ids`` (-1: not in a clump)."""
+        return self._clumps.of(ids)
+
+    @property
     def bond_mode(self) -> str:
         """The bond check in use ('auto' resolved)."""
         if self.bond_check != "auto":
             return self.bond_check
-        return "counters" if self._jcfpm else "sweep"
+        if self._jcfpm:
+            return "counters"
+        return "flags" if len(self._phys) <= FLAG_BUDGET else "sweep"
+
+    @property
+    def bond_check_calls(self) -> int:
+        """The calls within which a broken bond is seen: 1 (every flag read at every call, or
+        the crack counters), else the sweep's cycle."""
+        if self.bond_mode != "sweep":
+            return 1
+        if self.bond_check == "auto":
+            return -(-len(self._phys) // FLAG_BUDGET)
+        return self.sweep_calls
 
     # -- internals -----------------------------------------------------------------------
     def _stamp_now(self, count_real=True):
@@ -388,7 +432,7 @@ class SceneReader:
         if mode == "flags":
             lo, hi = 0, m
         else:
-            chunk = -(-m // self.sweep_calls)
+            chunk = -(-m // self.bond_check_calls)
             lo = self._sweep_at
             hi = min(m, lo + chunk)
             self._sweep_at = 0 if hi >= m else hi
@@ -404,8 +448,10 @@ class SceneReader:
 
     def _full_read(self):
         O = self.O
-        spheres = read_spheres(O, self.mask, keep=self.region)
+        spheres = read_spheres(O, self.mask, keep=self.region, clumps=self.clumps)
         ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
+        if spheres.clump is not None:
+            self._clumps.update(ids, spheres.clump)
         index = {int(i): k for k, i in enumerate(ids)}
         edges, phys, flags, cut = [], [], [], []
         flag_of_type = {}
@@ -430,8 +476,16 @@ class SceneReader:
             phys.append(ph)
             flags.append(flag if self.bonds == "cohesive" else None)
         self._revision += 1
-        self.graph = ContactGraph(spheres.pos, rad, np.asarray(edges, dtype=np.int64).reshape(-1, 2), ids,
-                                  self._revision)
+        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+        if spheres.clump is not None:             # the bonds inside clumps: of the members' geometry
+            inside = member_bonds(spheres.pos, rad, spheres.clump, self.clump_bond_factor)
+            n = len(ids)
+            known = np.sort(edges, axis=1) @ np.array([n, 1]) if len(edges) else np.zeros(0, np.int64)
+            edges = np.concatenate([edges, inside[~np.isin(inside @ np.array([n, 1]), known)]])
+        if self.isolated == "leave out" and self.bonds == "cohesive" and len(ids):
+            spheres, edges, cut = self._without_isolated(spheres, edges, cut)
+            ids, rad, bodies = spheres.ids, spheres.radius, spheres.bodies
+        self.graph = ContactGraph(spheres.pos, rad, edges, ids, self._revision)
         self.cut_nodes = np.unique(np.asarray(cut, dtype=np.int64))
         self._bodies, self._phys, self._flags = bodies, phys, flags
         # every bond of one phys type: read its flag attribute directly
@@ -450,9 +504,33 @@ class SceneReader:
         warn_left_out(spheres.ignored, self.ignored)
         self.ignored = spheres.ignored
         self.full_reads += 1
-        if self.bonds == "cohesive" and not edges:
+        if self.bonds == "cohesive" and not len(edges):
             log.warning("no cohesive bond between spheres: every element is isolated "
                         "(did the bonding step run? use Reader(bonds='contacts') for cohesionless packings)")
+
+    def _without_isolated(self, spheres, edges, cut):
+        """The spheres, edges (re-indexed) and cut nodes without the spheres that have no edge."""
+        n = len(spheres.ids)
+        linked = np.zeros(n, bool)
+        linked[np.asarray(edges, np.int64).ravel()] = True
+        if np.all(linked):
+            self.left_out = np.zeros(0, np.int64)
+            return spheres, edges, cut
+        if not np.any(linked):
+            raise GraphError(f"none of the {n} spheres has a bond: Reader(isolated='leave out') would leave every one "
+                             "out (did the bonding step run? a cohesionless packing is Reader(bonds='contacts'))")
+        new = np.cumsum(linked) - 1
+        gone = spheres.ids[~linked]
+        if not np.array_equal(gone, self.left_out):
+            log.warning("%d sphere(s) with no bond left out (Reader(isolated='leave out')): bodies %s%s", gone.size,
+                        gone[:20].tolist(), " ..." if gone.size > 20 else "")
+        self.left_out = gone
+        keep = np.flatnonzero(linked)
+        spheres = spheres._replace(ids=spheres.ids[keep], pos=spheres.pos[keep], radius=spheres.radius[keep],
+                                   bodies=[spheres.bodies[k] for k in keep], node_slot=spheres.node_slot[keep],
+                                   clump=None if spheres.clump is None else spheres.clump[keep])
+        cut = [int(new[c]) for c in cut if linked[c]]
+        return spheres, new[np.asarray(edges, np.int64)].reshape(-1, 2), cut
 
     def positions(self) -> np.ndarray:
         """Current centres (n, 3) [m] of the graph's elements, by YADE's C++ bulk reader."""
@@ -473,111 +551,6 @@ class SceneReader:
     def bodies(self) -> list:
         """The YADE bodies of the graph's nodes, in node order."""
         return self._bodies
-
-
-def _body_attributes():
-    """Attribute names YADE itself defines on bodies and states: never a write-back target."""
-    yade = import_yade()
-    return set(dir(yade.Body())) | set(dir(yade.State()))
-
-
-def check_write_back(name, bodies) -> None:
-    """Refuse a write-back attribute that is not an identifier, is one of YADE's own Body
-    attributes (``mask``, ``dynamic``, ...: writing potentials there would change the
-    simulation), or cannot be set on the bodies."""
-    if name is None:
-        return
-    if not isinstance(name, str) or not name.isidentifier():
-        raise ValueError(f"write_back must be an attribute name (an identifier) or None, got {name!r}")
-    if name in _body_attributes():
-        raise ValueError(f"write_back={name!r} is an attribute of YADE's Body or State: writing results there would "
-                         "change the simulation; choose a new name (e.g. 'potential') or None")
-    if bodies:
-        b = bodies[0]
-        try:
-            setattr(b, name, 0.0)
-        except Exception as exc:
-            raise ValueError(f"write_back={name!r} cannot be set on YADE bodies ({exc}); choose another name or "
-                             "None") from None
-
-
-def write_body_attribute(bodies, name: str, values) -> None:
-    """Set ``b.<name> = value`` on each body (a Python attribute YADE keeps on the body, so
-    ``yade.export.VTKExporter(...).exportSpheres(what=dict(potential='b.potential'))`` and
-    scripts can read it). YADE keeps such attributes only on bodies made in this process:
-    on a loaded scene read the values from the engine (``potential_by_id``). A dotted
-    ``name`` sets an attribute of a body's member, read afresh (``'state.temp'``: a script
-    may have given a body a new state)."""
-    # a C-level loop (map), a quarter faster than a Python for loop at 5,000 bodies (for
-    # 'state.temp', 0.56 against 0.65 ms at 2,000)
-    owner, _, attr = name.rpartition(".")
-    targets = map(operator.attrgetter(owner), bodies) if owner else bodies
-    deque(map(setattr, targets, repeat(attr), np.asarray(values, dtype=float).tolist()), maxlen=0)
-
-
-def ensure_thermal_state(bodies) -> int:
-    """Give every body a ``ThermalState`` (YADE's state with ``temp``), carrying over all the
-    attributes of its current state (position, velocity, mass, blocked DOFs...). Returns how
-    many states were replaced. (A plain ``State`` has no ``temp``: setting one there makes a
-    Python attribute that YADE neither saves nor shows.)"""
-    yade = import_yade()
-    replaced = 0
-    for b in bodies:
-        if not isinstance(b.state, yade.ThermalState):
-            ts = yade.ThermalState()
-            ts.updateAttrs(b.state.dict())
-            b.state = ts
-            replaced += 1
-    return replaced
-
-
-class TemperatureWriter:
-    """Writes temperatures [K] to ``b.state.temp`` of a list of bodies through their State
-    handles, kept between calls.
-
-    Taking ``b.state`` of every body at every call cost more than the writes themselves:
-    measured on the drum's 2,038 spheres in one process, 0.53 ms a call with the handles
-    taken afresh against 0.19 ms with kept ones. The handles are taken again (and every
-    state made a ``ThermalState``) whenever ``bodies`` is another list (the reader's full
-    read: bodies added or erased, a new scene). A script may also give a body a new state
-    (``b.state = ...``) between calls: each call compares 1/``sweep_calls`` of the kept
-    handles with the bodies' states (YADE's ``==``, a pointer comparison), in turn, so such a
-    state gets the temperatures within ``sweep_calls`` calls (default 8; 1 checks every
-    body at every call), made a ``ThermalState`` first if it is not one.
-
-    Attributes: ``refreshes`` (how many times the handles were taken), ``replaced_states``
-    (states found replaced by a script)."""
-
-    def __init__(self, sweep_calls: int = 8):
-        if isinstance(sweep_calls, bool) or not isinstance(sweep_calls, int) or sweep_calls < 1:
-            raise ValueError(f"sweep_calls must be an integer >= 1, got {sweep_calls!r}")
-        self.sweep_calls = sweep_calls
-        self.refreshes = self.replaced_states = 0
-        self._bodies = None
-        self._states: List = []
-        self._next = 0
-
-    def write(self, bodies, values) -> None:
-        """Set ``b.state.temp = value`` for each body, in order (``values`` [K], one per body)."""
-        if bodies is not self._bodies or len(self._states) != len(bodies):
-            self._refresh(bodies)
-        elif bodies:
-            n = len(bodies)
-            chunk = -(-n // self.sweep_calls)
-            lo, hi = self._next, min(self._next + chunk, n)
-            self._next = 0 if hi >= n else hi
-            now = map(operator.attrgetter("state"), bodies[lo:hi])
-            if not all(map(operator.eq, now, self._states[lo:hi])):
-                self.replaced_states += sum(1 for b, s in zip(bodies, self._states) if b.state != s)
-                self._refresh(bodies)
-        deque(map(setattr, self._states, repeat("temp"), np.asarray(values, dtype=float).tolist()), maxlen=0)
-
-    def _refresh(self, bodies) -> None:
-        ensure_thermal_state(bodies)
-        self._bodies = bodies
-        self._states = [b.state for b in bodies]
-        self._next = 0
-        self.refreshes += 1
 
 
 def predicate_selector(predicate, whole: bool = False):

@@ -73,7 +73,8 @@ def bonded_packing(centers, radii, shape, seed: int = 0):
     """The :class:`~yade_electro.packing.SpherePacking` of given centres and radii in the
     container ``shape`` (a :mod:`yade_electro.geometry.shapes` shape or YADE predicate), for
     :func:`~.bonding.add_bonded_packing`: an imported packing bonded as a solid."""
-    from ..geometry.shapes import as_shape, container_volume
+    from ..geometry.shapes import as_shape
+    from ..geometry.volumes import container_volume
     from ..packing import SpherePacking
     from ..packing.jamming import max_overlap
     c = np.asarray(centers, dtype=float).reshape(-1, 3)
