@@ -225,11 +225,12 @@ def worker(kinds, sizes, repeat, cache_dir):
 def run_ranks(ranks, kinds, sizes, repeat, cache_dir):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    from yade_electro.core.mpi_network import private_network
     cmd = ["mpiexec", "--oversubscribe", "-n", str(ranks), sys.executable, os.path.abspath(__file__), "--worker",
            "--systems", ",".join(kinds), "--sizes", ",".join(map(str, sizes)), "--repeat", str(repeat)]
     if cache_dir:
         cmd += ["--cache-dir", cache_dir]
-    res = subprocess.run(cmd, env=env, capture_output=True, text=True, stdin=subprocess.DEVNULL)
+    res = subprocess.run(private_network(cmd), env=env, capture_output=True, text=True, stdin=subprocess.DEVNULL)
     if res.returncode != 0:
         raise RuntimeError(f"mpiexec -n {ranks} failed: {res.stderr[-3000:]}")
     return [json.loads(line) for line in res.stdout.splitlines() if line.startswith("{")]

@@ -82,7 +82,8 @@ def run_worker(ranks, sizes):
                OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     cmd = ["mpiexec", "-n", str(ranks), sys.executable, os.path.abspath(__file__), "--worker",
            "--sizes", ",".join(map(str, sizes))]
-    out = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True)
+    from yade_electro.core.mpi_network import private_network
+    out = subprocess.run(private_network(cmd), env=env, check=True, capture_output=True, text=True)
     return [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
 
 

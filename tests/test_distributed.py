@@ -9,6 +9,7 @@ import subprocess
 
 import pytest
 
+from yade_electro.core.mpi_network import private_network
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
@@ -18,7 +19,7 @@ MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
 def _mpiexec(args, n, timeout=900):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, env.get("PYTHONPATH")) if p)
-    cmd = ["mpiexec", "--oversubscribe", "-n", str(n)] + list(args)
+    cmd = private_network(["mpiexec", "--oversubscribe", "-n", str(n)] + list(args))     # off the network
     return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 
@@ -63,6 +64,7 @@ def test_walls_held_by_the_master_in_yade_mpy(yade_exe):
 BAD_SCRIPT = """
 import numpy as np
 from yade import pack
+from yade_electro.core.mpi_network import private_network
 from yade_electro.yade import ElectricalEngine, Electrode, Material
 from yade_electro.core.errors import BoundaryConditionError
 for i in range(4):

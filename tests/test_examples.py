@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import REPO_ROOT, repo_env
+from yade_electro.core.mpi_network import private_network
 
 EXAMPLES = REPO_ROOT / "examples"
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "OPENBLAS_NUM_THREADS": "1",
@@ -55,7 +56,7 @@ def test_packing_cross_check(run_yade_script, liggghts_exe):
 
 def test_mpi_petsc(yade_exe, tmp_path):
     env = dict(repo_env(), **MPI_ENV)
-    cmd = ["mpiexec", "--oversubscribe", "-n", "2"] + yade_exe + ["-n", "-x", str(EXAMPLES / "mpi_petsc.py")]
+    cmd = private_network(["mpiexec", "--oversubscribe", "-n", "2"] + yade_exe + ["-n", "-x", str(EXAMPLES / "mpi_petsc.py")])
     res = subprocess.run(cmd, env=env, cwd=str(tmp_path), capture_output=True, text=True, timeout=600,
                          stdin=subprocess.DEVNULL)
     assert res.returncode == 0, res.stderr[-3000:]

@@ -10,6 +10,7 @@ import pytest
 import scipy.sparse as sp
 
 from lattice import cubic_lattice
+from yade_electro.core.mpi_network import private_network
 from yade_electro.core.errors import GraphError
 from yade_electro.network.partition import LocalNetwork, OwnedRows, split_network
 
@@ -76,7 +77,7 @@ def test_local_network_refuses_bad_shares():
 def _mpiexec(args, n, timeout=600):
     env = dict(os.environ, **MPI_ENV)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, env.get("PYTHONPATH")) if p)
-    cmd = ["mpiexec", "--oversubscribe", "-n", str(n)] + list(args)
+    cmd = private_network(["mpiexec", "--oversubscribe", "-n", str(n)] + list(args))     # off the network
     return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 

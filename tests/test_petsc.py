@@ -12,6 +12,7 @@ import pytest
 
 from lattice import cubic_lattice
 
+from yade_electro.core.mpi_network import private_network
 from yade_electro import Electrode, SolverError
 from yade_electro.network.conduction import ConductionProblem
 from yade_electro.solvers.registry import check_solver_name, make_solver, solver_names
@@ -45,7 +46,7 @@ def _json_rows(text):
 def _mpiexec(args, n, timeout=600, extra_env=None):
     env = dict(os.environ, **MPI_ENV, **(extra_env or {}))
     env["PYTHONPATH"] = os.pathsep.join(p for p in (ROOT, env.get("PYTHONPATH")) if p)
-    cmd = ["mpiexec", "--oversubscribe", "-n", str(n)] + list(args)
+    cmd = private_network(["mpiexec", "--oversubscribe", "-n", str(n)] + list(args))     # off the network
     return subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 

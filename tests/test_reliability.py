@@ -158,3 +158,37 @@ def test_crafted_campaign_logs_and_batch_names(tmp_path):
     with pytest.raises(SystemExit, match=r"row 3, column !SCRIPT"):
         check_batch_words([str(t), "cases/ok.py"])
     check_batch_words(["--log", "/tmp/x/$.@.log", "cases/rod_resistance.py"])
+
+
+@pytest.mark.parametrize("helper", ["not executable", "fails", "cut short"])
+def test_a_broken_delaunay_helper_falls_back_to_qhull(tmp_path, monkeypatch, helper):
+    """Item 9: the kernels and the CGAL helper are built at install into the package (no cache
+    folder, no compiler at run time: a planted library elsewhere is never loaded); a helper that
+    cannot run, fails or writes a cut-short output makes the tessellation fall back to qhull with
+    a warning, with qhull's answer."""
+    import yade_electro.native as native
+    from yade_electro.geometry.tessellation import tessellate
+    from yade_electro.native.loader import HERE, library_path
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    (tmp_path / "_graph_hops.so").write_bytes(b"planted")
+    try:
+        assert library_path("graph_hops").parent == HERE       # the package's, never a cache's
+    except native.NativeError:
+        pytest.skip("the kernels are not built here")
+    fake = tmp_path / "delaunay_cgal"
+    if helper == "not executable":
+        fake.write_text("#!/bin/sh\nexit 0\n")
+        fake.chmod(0o644)
+    elif helper == "fails":
+        fake.write_text("#!/bin/sh\necho broken >&2\nexit 1\n")
+        fake.chmod(0o755)
+    else:
+        fake.write_text('#!/bin/sh\nprintf "\\001\\000\\000\\000" > "$2"\nexit 0\n')
+        fake.chmod(0o755)
+    monkeypatch.setattr(native, "cgal_executable", lambda: fake)
+    pts = np.random.default_rng(3).random((400, 3))
+    with pytest.warns(UserWarning, match="tessellating with qhull instead"):
+        t = tessellate(pts, 400, backend="cgal")
+    ref = tessellate(pts, 400, backend="qhull")
+    assert np.array_equal(np.asarray(t.ridge_points), np.asarray(ref.ridge_points))

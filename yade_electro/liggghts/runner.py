@@ -158,12 +158,15 @@ def run_deck(deck, workdir, files=None, exe=None, timeout: float = 600.0, deck_n
     for p in (log, out):
         if p.exists():
             p.unlink()
+    from ..core.mpi_network import private_network, singleton_env
     cmd = [binary, "-in", deck_path.name, "-log", log.name, "-nocite"]
     if shutil.which("stdbuf"):
         cmd = ["stdbuf", "-o0", "-e0"] + cmd
-    if ranks != 1:
-        cmd = mpi_command(ranks) + cmd
     env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
+    if ranks != 1:                # off the network: mpiexec in a namespace of its own (loopback only)
+        cmd = private_network(mpi_command(ranks) + cmd)
+    else:                         # LIGGGHTS is an MPI program: alone, a singleton with no daemon, no TCP
+        env = singleton_env(env)
     t0 = time.perf_counter()
     last_print = t0
     with open(out, "w") as fh:

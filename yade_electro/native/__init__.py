@@ -107,8 +107,12 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
             P.tofile(fh)
         from ..core.progress import Progress
         progress = Progress("voronoi", f"{P.shape[0]:,} points triangulated by CGAL")
-        proc = subprocess.Popen([str(exe), fin, fout, str(int(n_real))], stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)
+        try:
+            proc = subprocess.Popen([str(exe), fin, fout, str(int(n_real))], stdout=subprocess.PIPE,
+                                    stderr=subprocess.PIPE, text=True)
+        except OSError as exc:           # not executable, not a program: the caller falls back to qhull
+            progress.done()
+            raise NativeError(f"delaunay_cgal cannot run ({exc})") from None
         while True:                      # a long triangulation (about 20 s at 1M) shows progress
             progress.waiting("the helper process runs")
             try:
@@ -121,15 +125,18 @@ def cgal_delaunay(points, n_real: int, tmpdir: Optional[str] = None):
             raise NativeError("delaunay_cgal: some points coincide (CGAL keeps one of each)")
         if proc.returncode != 0:
             raise NativeError(f"delaunay_cgal failed (exit {proc.returncode}): {err.strip()[-500:]}")
-        with open(fout, "rb") as fh:
-            nv, nc, ne, ni = (int(v) for v in np.fromfile(fh, np.int64, 4))
-            cells = np.fromfile(fh, np.int64, 4 * nc).reshape(nc, 4)
-            cc = np.fromfile(fh, np.float64, 3 * nc).reshape(nc, 3)
-            pairs = np.fromfile(fh, np.int64, 2 * ne).reshape(ne, 2)
-            counts = np.fromfile(fh, np.int64, ne)
-            around = np.fromfile(fh, np.int64, ni)
-    if around.size != ni or counts.sum() != ni:
-        raise NativeError("delaunay_cgal: short output")
+        try:
+            with open(fout, "rb") as fh:
+                nv, nc, ne, ni = (int(v) for v in np.fromfile(fh, np.int64, 4))
+                cells = np.fromfile(fh, np.int64, 4 * nc).reshape(nc, 4)
+                cc = np.fromfile(fh, np.float64, 3 * nc).reshape(nc, 3)
+                pairs = np.fromfile(fh, np.int64, 2 * ne).reshape(ne, 2)
+                counts = np.fromfile(fh, np.int64, ne)
+                around = np.fromfile(fh, np.int64, ni)
+        except (OSError, ValueError) as exc:         # no output, or cut short: not a triangulation
+            raise NativeError(f"delaunay_cgal: unreadable output ({exc})") from None
+    if around.size != ni or counts.sum() != ni or (cells.size and (cells.min() < 0 or cells.max() >= P.shape[0])):
+        raise NativeError("delaunay_cgal: short or inconsistent output")
     return cells, cc, pairs, counts, around
 
 

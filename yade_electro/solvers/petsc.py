@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import glob
 import os
+import subprocess
 import sys
 import time
 from typing import Optional
@@ -67,7 +68,15 @@ def petsc4py_location() -> Optional[str]:
 
 def import_petsc():
     """The ``PETSc`` module of petsc4py (initialised), importing it from Debian's directory
-    when the ``/usr/lib/petsc`` link is missing. Raises :class:`SolverError` when absent."""
+    when the ``/usr/lib/petsc`` link is missing. Raises :class:`SolverError` when absent.
+    Outside ``mpiexec`` the MPI singleton it starts is kept off the network
+    (:func:`~yade_electro.core.mpi_network.quiet_singleton`)."""
+    from ..core.mpi_network import quiet_singleton, under_mpiexec
+    quiet_singleton()
+    if "petsc4py.PETSc" in sys.modules:
+        return sys.modules["petsc4py.PETSc"]
+    if not under_mpiexec():
+        _probe_mpi_start()
     try:
         from petsc4py import PETSc
         return PETSc
@@ -87,6 +96,28 @@ def import_petsc():
                 raise SolverError(f"petsc4py found in {path} but it does not import ({exc}); "
                                   + _INSTALL_HINT) from None
     raise SolverError(_INSTALL_HINT)
+
+
+def _probe_mpi_start():
+    """SolverError saying what happened when Open MPI cannot start in a process of this
+    environment: its ``MPI_Init`` would abort the whole program (YADE included) with no Python
+    error. Tried once in a child process first (about 0.3 s)."""
+    path = petsc4py_location()
+    if path is None:
+        return                                  # the import below says petsc4py is missing
+    code = (f"import sys; sys.path.append({path!r}); import petsc4py; petsc4py.init([]); "
+            "from petsc4py import PETSc; print('MPI-OK', PETSc.COMM_WORLD.getSize())")
+    try:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                           stdin=subprocess.DEVNULL)
+    except (OSError, subprocess.SubprocessError) as exc:
+        raise SolverError(f"solver='petsc': could not try starting Open MPI ({exc})") from None
+    if r.returncode != 0 or "MPI-OK" not in r.stdout:
+        said = [ln.strip() for ln in (r.stderr + r.stdout).splitlines() if ln.strip() and not ln.startswith("---")]
+        raise SolverError("solver='petsc': Open MPI cannot start in this environment, and starting it here would "
+                          "abort the whole program without a Python error. It said: " + " | ".join(said[-6:])
+                          + ". Use a solver without MPI (solver='auto'), or fix the MPI environment (a network "
+                          "interface, OMPI_MCA_* settings) and run under mpiexec")
 
 
 def check_preconditioner(preconditioner: str):
