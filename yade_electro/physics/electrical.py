@@ -387,12 +387,12 @@ class ElectricalModel:
         """BoundaryConditionError when two surface electrodes hold the same boundary faces, or an
         electrode's elements are also linked to a surface electrode: either shorts the two
         (overlapping element selections are refused by the conduction problem)."""
+        from ..geometry.boundary import shared_faces
         n = graph.n_nodes
         contacts = {s.name: self._surface_contact(s, graph) for s in self.specs if s.surface is not None and not s.wall}
         names = list(contacts)
         for i, a in enumerate(names):
             for b in names[i + 1:]:
-                from ..geometry.boundary import shared_faces
                 k = shared_faces(contacts[a], contacts[b])
                 if k:
                     raise BoundaryConditionError(

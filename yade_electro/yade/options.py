@@ -69,7 +69,7 @@ class Reader:
         1/``sweep_calls`` of the bond flags per call, ``'flags'`` all of them every call,
         ``'counters'`` YADE's JCFpm crack counters; ``'auto'`` picks the counters with JCFpm,
         else reads at most 2,500 flags a call: all of them up to 2,500 bonds, else a sweep
-        over the calls that needs (see :mod:`yade_electro.yade.scene`). The history rows'
+        over the calls that needs, ``sweep_calls`` at most (see :mod:`yade_electro.yade.scene`). The history rows'
         ``bond_check_calls`` say within how many calls a break is seen.
     sweep_calls : int
         Calls over which ``'sweep'`` reads every bond once (default 8).

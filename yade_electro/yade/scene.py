@@ -36,9 +36,9 @@ bond per read of its flag:
 * ``'auto'`` (default): ``'counters'`` when the scene has a JCFpm law; else ``'flags'`` up to
   :data:`FLAG_BUDGET` bonds (2,500: about 0.5 ms a call), so that a break is seen at the next
   call, and beyond that ``'sweep'`` over the fewest calls that read at most that many flags a
-  call (7 calls for the 5,000-element rod's 16,851 bonds). How many calls a break may take to
-  be seen is :attr:`SceneReader.bond_check_calls`, in each history row as
-  ``bond_check_calls`` (1: at the next call);
+  call, ``sweep_calls`` (8) at most (7 calls for the 5,000-element rod's 16,851 bonds). How
+  many calls a break may take to be seen is :attr:`SceneReader.bond_check_calls`, in each
+  history row as ``bond_check_calls`` (1: at the next call);
 * ``'sweep'``: each call reads the flags of 1/``sweep_calls`` of the bonds, in turn: every
   bond is checked every ``sweep_calls`` calls (default 8: 0.4 ms a call at 5,000
   elements), so such a break is seen within ``sweep_calls`` calls; real interactions are
@@ -70,8 +70,8 @@ from ..network.lumping import MemberLabels, member_bonds
 from ..packing.statistics import DEFAULT_DETECTION_FACTOR
 from .runtime import import_yade
 
-__all__ = ["SceneReader", "predicate_selector", "BOND_CHECKS", "FLAG_BUDGET", "SphereBodies", "read_spheres", "bulk_coordinates", "probe_replaced",
-           "warn_left_out", "PERIODIC_REFUSAL"]
+__all__ = ["SceneReader", "predicate_selector", "BOND_CHECKS", "FLAG_BUDGET", "SphereBodies", "read_spheres",
+           "bulk_coordinates", "probe_replaced", "warn_left_out", "PERIODIC_REFUSAL"]
 
 log = logging.getLogger(__name__)
 
@@ -403,8 +403,8 @@ class SceneReader:
         the crack counters), else the sweep's cycle."""
         if self.bond_mode != "sweep":
             return 1
-        if self.bond_check == "auto":
-            return -(-len(self._phys) // FLAG_BUDGET)
+        if self.bond_check == "auto":       # the budget's calls, never more than the sweep's
+            return min(self.sweep_calls, -(-len(self._phys) // FLAG_BUDGET))
         return self.sweep_calls
 
     # -- internals -----------------------------------------------------------------------
