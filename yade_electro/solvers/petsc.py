@@ -73,9 +73,8 @@ def import_petsc():
     (:func:`~yade_electro.core.mpi_network.quiet_singleton`)."""
     from ..core.mpi_network import quiet_singleton, under_mpiexec
     quiet_singleton()
-    if "petsc4py.PETSc" in sys.modules:
-        return sys.modules["petsc4py.PETSc"]
-    if not under_mpiexec():
+    started = sys.modules.get("petsc4py") is not None and "petsc4py.PETSc" in sys.modules
+    if not started and not under_mpiexec():       # (once: MPI is up after the first import)
         _probe_mpi_start()
     try:
         from petsc4py import PETSc
