@@ -4,21 +4,14 @@ the clumps are read resolved (their members bonded by their geometry): the same 
 temperatures; lumped, the same R_eq (currents flow member by member) and one temperature per
 clump, written on the members and the clump; without ``clumps`` they are left out."""
 
-SCRIPT = r'''
+from yade_snippets import BONDED_ROD
+
+SCRIPT = BONDED_ROD + r'''
 import json, math
 import numpy as np
 from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, HeatEngine, Electrode, Integrator, Material, Reader, FixedTemperature
-from yade_electro.yade import packing as P
-L, RAD = 2e-3, 0.5e-3
-rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
 RHO = 7.3e-7
 mat = Material(resistivity=RHO, density=7900.0, specific_heat=500.0, conductivity=16.2)
-def build():
-    O.reset()
-    P.add_bonded_packing(P.dense_packing(rod, n=400, seed=3))
-    for e in O.engines:
-        if type(e).__name__ == "NewtonIntegrator":
-            e.dead = True
 def engine(label, reader=Reader()):
     return ElectroThermalEngine(material=mat, reader=reader,
         boundaries=[Electrode("top", surface=rod.face("top"), potential=0.05),

@@ -1,17 +1,12 @@
 """Reliability on real YADE (issue 36): what a demanding user hit, each provoked."""
+from yade_snippets import BONDED_ROD
 
-RIGID = r'''
+RIGID = BONDED_ROD + r'''
 import json, math
 import numpy as np
 from yade_electro.yade import ElectroThermalEngine, Electrode, Material, Integrator, FixedTemperature
-from yade_electro.yade import packing as P
-L, RAD = 2e-3, 0.5e-3
-rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
-def build():
-    O.reset()
-    P.add_bonded_packing(P.dense_packing(rod, n=400, seed=3))
-    for e in O.engines:
-        if type(e).__name__ == "NewtonIntegrator": e.dead = True
+def build_engine():
+    build()
     eng = ElectroThermalEngine(material=Material(resistivity=7.3e-7, density=7900.0, specific_heat=500.0, conductivity=16.2),
         boundaries=[Electrode("top", surface=rod.face("top"), potential=0.05), Electrode("bottom", surface=rod.face("bottom"), potential=0.0),
                     FixedTemperature("cold", surface=rod.face("bottom"), temperature=300.0)],
@@ -34,8 +29,8 @@ def restructure(eng, moved):
     O.bodies.append(sphere(pos, r))
     O.run(3, True)
     return R_moved, R_erased, eng.equivalent_resistance, float(eng.history.rows[-1]["T_max"])
-e = build(); still = restructure(e, False)
-e = build(); moved = restructure(e, True)
+e = build_engine(); still = restructure(e, False)
+e = build_engine(); moved = restructure(e, True)
 print(json.dumps({"still": still, "moved": moved}))
 '''
 
@@ -97,12 +92,9 @@ def test_electrodes_that_would_short_or_sit_inside_the_solid_are_refused(run_yad
     assert isinstance(out["adjacent"], float) and 1e-4 < out["adjacent"] < 1e-2, out
 
 
-BUILD = r'''
+BUILD = BONDED_ROD + r'''
 import json
 from yade_electro.yade import HeatEngine, ElectricalEngine, ElectroThermalEngine, Electrode, Material, Integrator, FixedTemperature, HeatSource, Reader, Law
-from yade_electro.yade import packing as P
-L, RAD = 2e-3, 0.5e-3
-rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
 heat_mat = Material(density=7900.0, specific_heat=500.0, conductivity=16.2)
 out = {}
 def attempt(name, make):
@@ -114,11 +106,6 @@ def attempt(name, make):
         e.remove()
     except Exception as exc:
         out[name] = "REFUSED " + type(exc).__name__ + ": " + str(exc)
-def build():
-    O.reset()
-    P.add_bonded_packing(P.dense_packing(rod, n=400, seed=3))
-    for e in O.engines:
-        if type(e).__name__ == "NewtonIntegrator": e.dead = True
 cold = FixedTemperature("cold", surface=rod.face("bottom"), temperature=300.0)
 # 4: a loose sphere outside the container
 build(); O.bodies.append(sphere((0, 0, 5e-3), 0.05e-3))

@@ -6,22 +6,15 @@ to the 'voronoi' law and take ``rod.face(...)`` surfaces without being told the 
 """
 import pytest
 
-COMMON = r'''
+from yade_snippets import BONDED_ROD
+
+COMMON = BONDED_ROD + r'''
 import json, math
 import numpy as np
 from yade_electro.yade import ElectricalEngine, ElectroThermalEngine, HeatEngine, attach, Electrode, Integrator, Law, Material
-from yade_electro.yade import packing as P
 from yade_electro.yade import FixedTemperature, Convection
 from yade_electro.yade import HeatSource
-L, RAD = 2e-3, 0.5e-3
-rod = P.Cylinder((0, 0, 0), (0, 0, L), RAD)
 RHO, LAM = 7.3e-7, 16.2
-def build():
-    O.reset()
-    P.add_bonded_packing(P.dense_packing(rod, n=400, seed=3))
-    for e in O.engines:
-        if type(e).__name__ == "NewtonIntegrator":
-            e.dead = True
 '''
 
 STEADY = COMMON + r'''

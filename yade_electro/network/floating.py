@@ -38,9 +38,9 @@ def floating_message(n_nodes: int, n_parts: int, reached: str, kept: str) -> str
             f"rest and keep {kept} (see the results' floating mask)")
 
 
-def warn_floating(n_nodes: int, n_parts: int, reached: str, kept: str, stacklevel: int = 3) -> None:
-    """Warn once about floating nodes (see :func:`floating_message`)."""
-    warnings.warn(floating_message(n_nodes, n_parts, reached, kept), stacklevel=stacklevel)
+def warn_floating(n_nodes: int, n_parts: int, reached: str, kept: str, stacklevel: int = 3, detail: str = "") -> None:
+    """Warn once about floating nodes (see :func:`floating_message`), with ``detail`` after."""
+    warnings.warn(floating_message(n_nodes, n_parts, reached, kept) + detail, stacklevel=stacklevel)
 
 
 def no_steady_state_message(n_nodes: int, n_parts: int, reached: str, inflow: str, remedy: str) -> str:
@@ -113,11 +113,8 @@ def floating_parts(matrix, anchored, inflow, *, reached: str, kept: str, inflow_
         raise error(no_steady_state_message(int(np.sum(bad[labels])), int(np.sum(bad)), reached, inflow_name, remedy)
                     + which_elements(names, bad[labels], labels, alone_remedy))
     floating = ~anchor[labels]
-    if names is None:
-        warn_floating(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept, stacklevel=stacklevel)
-    else:
-        warnings.warn(floating_message(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept)
-                      + which_elements(names, floating, labels, alone_remedy), stacklevel=stacklevel)
+    warn_floating(int(np.sum(floating)), int(np.sum(~anchor)), reached, kept, stacklevel=stacklevel,
+                  detail=which_elements(names, floating, labels, alone_remedy))
     return labels, floating
 
 

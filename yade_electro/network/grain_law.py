@@ -242,9 +242,9 @@ class GrainLaw(ContactLaw):
             factor.append(A / (da + db))
             area.append(A)
             grain_pair.append(np.tile([i, j], (A.size, 1)))
-        for key in [k for k in self._cache if k not in contacts]:
-            if key not in {tuple(p) for p in ge.tolist()}:
-                del self._cache[key]             # apart: made again when they meet
+        near = {tuple(p) for p in ge.tolist()}
+        for key in [k for k in self._cache if k not in near]:
+            del self._cache[key]                 # apart: made again when they meet
         edges = np.concatenate(edges).astype(np.int64)
         keys = edges[:, 0] * graph.n_nodes + edges[:, 1]
         self._made = (graph, edges, keys, np.concatenate(factor), np.concatenate(area),
@@ -272,8 +272,8 @@ class GrainLaw(ContactLaw):
         rows = self._lookup(graph, edges)
         return np.where(rows >= 0, self._made[3][np.maximum(rows, 0)], 0.0)
 
-    def _per_area(self, graph, edges, specific) -> np.ndarray:
-        rows = self._lookup(graph, edges)
+    def _per_area(self, rows, specific) -> np.ndarray:
+        """``specific / A_ij`` on the rows of the last network that are contact links (0 elsewhere)."""
         A = np.where(rows >= 0, self._made[4][np.maximum(rows, 0)], 0.0)
         out = np.zeros(rows.size)
         link = A > 0
@@ -284,9 +284,9 @@ class GrainLaw(ContactLaw):
         """The contact resistance ``R_c / A_ij`` [K/W] in series with each edge's half cells (0
         inside a grain; inf on a contact that carries no force under a pressure law)."""
         rc = self.contact_resistance
-        if not callable(rc):
-            return self._per_area(graph, edges, rc)
         rows = self._lookup(graph, edges)
+        if not callable(rc):
+            return self._per_area(rows, rc)
         pair = self._made[5][np.maximum(rows, 0)]
         link = (rows >= 0) & (pair[:, 0] >= 0)
         spec = np.zeros(rows.size)
@@ -308,16 +308,17 @@ class GrainLaw(ContactLaw):
                         raise BoundaryConditionError(f"contact_resistance({p:.6g} Pa) of grains {tuple(grains[k])}: "
                                                      f"{exc}") from None
             spec[link] = spec_pair[inv.ravel()]
-        return self._per_area(graph, edges, spec)
+        return self._per_area(rows, spec)
 
     def film_resistance(self, graph, edges=None) -> np.ndarray:
         """The film's resistance ``film / A_ij`` [ohm] across each contact link (0 elsewhere)."""
-        return self._per_area(graph, edges, self.film) if self.film else np.zeros(self._lookup(graph, edges).size)
+        rows = self._lookup(graph, edges)
+        return self._per_area(rows, self.film) if self.film else np.zeros(rows.size)
 
     def cell_volumes(self, graph) -> np.ndarray:
         """Each element's cell volume [m^3] (its template's)."""
-        g, e = self.grains.locate(graph.ids)
-        self._nodes(graph)
-        volume = np.concatenate([self.grains.template(k).volume for k in range(self.grains.n)])
-        first = np.cumsum([0] + [m.size for m in self.grains.members])[:-1]
-        return volume[first[g] + e]
+        _, nodes = self._nodes(graph)
+        volume = np.empty(graph.n_nodes)
+        for k, at in enumerate(nodes):
+            volume[at] = self.grains.template(k).volume
+        return volume

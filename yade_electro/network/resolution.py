@@ -157,7 +157,7 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
     q = np.zeros(n)
     terms = {}
     for b in injections:
-        q_before = q.copy()
+        q_before = q.copy()                     # (what this one adds: its term)
         nd = nodes(b)
         rate, density = b.field("rate"), b.field("density")
         if b.name in area_of:
@@ -179,7 +179,8 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
             np.add.at(q, nd, rate * share)
         else:
             np.add.at(q, nd, density * resolve_area(b, nd, n, default_area))
-        terms[b.name] = (np.unique(nd), None, q - q_before)
+        u = np.unique(nd)
+        terms[b.name] = (u, np.where(is_fixed[u], 0.0, (q - q_before)[u]))    # fixed nodes receive nothing
     if power is not None:
         pw = np.asarray(power, dtype=float)
         if pw.shape != (n,) or not np.all(np.isfinite(pw)):
@@ -192,16 +193,11 @@ def resolve_conditions(n: int, conditions: Sequence, *, graph: Optional[ContactG
                                        else resolve_area(b, nd, n, default_area))
         np.add.at(hA, nd, ha)
         np.add.at(hAT, nd, ha * b.field("ambient"))
-        terms[b.name] = (nd, ha, None)
+        terms[b.name] = (nd, np.where(is_fixed[nd], 0.0, ha))
     hA[is_fixed] = 0.0
     hAT[is_fixed] = 0.0
     q[is_fixed] = 0.0
     every = {**fixed_nodes, **{k: v[0] for k, v in links.items()},
              **{b.name: nodes(b) for b in injections + robins}}
-    for name, (nd, ha, added) in list(terms.items()):     # what fixed nodes do not receive
-        if ha is not None:
-            terms[name] = (nd, np.where(is_fixed[nd], 0.0, ha))
-        else:
-            terms[name] = (nd, np.where(is_fixed[nd], 0.0, added[nd]))
     return ResolvedConditions(fixed_nodes=fixed_nodes, links=links, fixed=is_fixed, power=q, h_area=hA,
                               h_area_t_inf=hAT, nodes_of=every, terms=terms)

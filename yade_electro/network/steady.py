@@ -8,6 +8,7 @@ Units: SI (W, K, W/K).
 from __future__ import annotations
 
 import logging
+import warnings
 
 import numpy as np
 
@@ -44,7 +45,6 @@ class SteadyHeatSolve:
         """ThermalError now when a part that receives heat (``sources`` [W per node], the
         fluxes and heat sources of this solver) reaches no fixed temperature and no convection:
         :meth:`steady` would fail there (engines call it when they are built)."""
-        import warnings
         src = np.zeros(self.n) if sources is None else np.asarray(sources, dtype=float)
         u = self._u
         with warnings.catch_warnings():

@@ -587,9 +587,9 @@ class ElectroThermalModel:
             "n_substeps": step.n_substeps if step is not None else 0,
             "n_potential_solves": self.n_potential_solves,
         })
-        row.update({f"heat_flow:{k}": v for k, v in heat.boundary_flows().items()})
+        flows = heat.boundary_flows()                   # (a wall's is its link's)
+        row.update({f"heat_flow:{k}": v for k, v in flows.items()})
         if self.walls:
-            flows = heat.link_flows()
             for w in self.walls:
                 if not w.isothermal:
                     continue                # adiabatic: nothing to report

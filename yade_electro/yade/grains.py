@@ -59,8 +59,7 @@ class GrainForces:
 
     def __call__(self, pairs) -> np.ndarray:
         O = self._O if self._O is not None else import_yade().Omega()
-        pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-        want = {(int(i), int(j)): k for k, (i, j) in enumerate(pairs)}
+        pairs = np.sort(np.asarray(pairs, np.int64).reshape(-1, 2), axis=1)
         total = np.zeros((pairs.shape[0], 3))
         ids1, ids2, forces = [], [], []
         for inter in O.interactions:
@@ -71,14 +70,16 @@ class GrainForces:
             ids2.append(inter.id2)
             f = phys.normalForce + phys.shearForce if hasattr(phys, "shearForce") else phys.normalForce
             forces.append(tuple(f))
-        if ids1:
-            g1, _ = self.grains.locate(ids1)
-            g2, _ = self.grains.locate(ids2)
-            F = np.asarray(forces, float)
-            for a, b, f in zip(g1, g2, F):
-                key = (int(min(a, b)), int(max(a, b)))
-                if a >= 0 and b >= 0 and a != b and key in want:
-                    total[want[key]] += f if a < b else -f
+        if ids1 and pairs.size:
+            g1, g2 = self.grains.locate(ids1)[0], self.grains.locate(ids2)[0]
+            F = np.asarray(forces, float) * np.where(g1 < g2, 1.0, -1.0)[:, None]   # from the lower grain's side
+            n = max(self.grains.n, 1)
+            want = pairs[:, 0] * n + pairs[:, 1]
+            order = np.argsort(want)
+            key = np.minimum(g1, g2) * n + np.maximum(g1, g2)
+            at = np.minimum(np.searchsorted(want[order], key), want.size - 1)
+            hit = (g1 >= 0) & (g2 >= 0) & (g1 != g2) & (want[order][at] == key)
+            np.add.at(total, order[at[hit]], F[hit])
         return np.linalg.norm(total, axis=1)
 
 
