@@ -19,9 +19,12 @@ def test_faces_of_combined_shapes_are_reachable():
     pk = dense_packing(shape, n=600, seed=1)
     cells = bounded_cells(pk.centers, pk.radii, shape)
     bottom = surface_contact(cells, pk.centers, shape.face("b.z-"), container=shape)
-    # the notch's floor (the bounded cells chamfer the re-entrant corners: 82 % of it is flat)
-    assert 0.75 < bottom.total_area / (0.8e-3 * 2e-3) <= 1.0
-    assert np.all(np.abs(pk.centers[bottom.nodes, 0] - 5e-3) < 0.7e-3)         # elements at the notch
+    # the notch's floor: the cells at its re-entrant edges are measured by sampling, whose
+    # shell is high along those edges (cell_clipping.sampled_boundary): 101-104 % of it on
+    # three packings (82 % while ghosts left gaps at those edges)
+    assert 0.95 < bottom.total_area / (0.8e-3 * 2e-3) < 1.06
+    # elements at the notch (a cell at its edge may wrap around it: within two radii)
+    assert np.all(np.abs(pk.centers[bottom.nodes, 0] - 5e-3) < 0.4e-3 + 2 * np.mean(pk.radii))
     left = surface_contact(cells, pk.centers, shape.face("a.x-"), container=shape)
     assert left.total_area == pytest.approx(2e-3 * 2e-3, rel=0.02)
     with pytest.raises(ValueError, match="name it 'a.x-' or 'b.x-'"):

@@ -157,8 +157,9 @@ def test_half_cell_length_is_exact_under_cylindrical_walls():
 
 def test_coaxial_resistance_with_electrodes_on_both_curved_walls():
     """cases/coax_resistance.py: rho ln(b/a) / (2 pi L) between the hole's surface and the outer
-    one. Measured at 5,000 elements (seed 1): +0.13 % with the curvature correction, +0.63 %
-    with flat half cells."""
+    one. Measured at 5,000 elements (seed 1): +0.14 % with the curvature correction, +0.64 %
+    with flat half cells (+0.13 / +0.63 % before the cells near the tube's end edges were
+    closed without gaps)."""
     import os
     import sys
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "cases"))

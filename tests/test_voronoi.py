@@ -85,9 +85,18 @@ def test_hops_widen_the_network_and_faces_are_reused():
     g2 = law1.factor(moved, n1.reshape(-1, 2))
     assert law1.area_lookups == 1
     np.testing.assert_allclose(g2, g1 / 1.01, rtol=1e-12)
-    n3 = make_law("voronoi", container=box, hops=3).network(graph)
-    assert n3.shape[0] >= n1.shape[0]
-    np.testing.assert_array_equal(n1, np.unique(np.sort(graph.edges, axis=1), axis=0))
+    law3 = make_law("voronoi", container=box, hops=3)
+    n3 = law3.network(graph)
+    # intact, every face of the solid conducts, whatever hops: pairs farther apart than hops
+    # along the bonds conduct while they are no farther than in the reference
+    every = np.unique(np.concatenate([faces.pairs, np.sort(graph.edges, axis=1)]), axis=0)
+    np.testing.assert_array_equal(n1, every)
+    np.testing.assert_array_equal(n3, every)
+    # bonds broken: a pair conducts while linked within max(hops, its reference distance), so
+    # a larger hops keeps more
+    broken = graph.with_edges(graph.edges[::2])
+    m1, m3 = law1.network(broken), law3.network(broken)
+    assert m3.shape[0] >= m1.shape[0] and m1.shape[0] < faces.pairs.shape[0]
 
 
 def test_voronoi_needs_a_container():

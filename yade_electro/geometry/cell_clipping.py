@@ -77,9 +77,15 @@ def clipped_area(poly, normal, container, max_rounds=8, rel_tol=1e-2):
         feet, g = tangent_planes(poly, d, container, tol)
         if feet.shape[0] == 0:
             break
-        # a plane may remove only what is outside the solid (not so at a re-entrant corner)
-        removed = np.einsum("vk,pk->pv", poly, g) - np.einsum("pk,pk->p", feet, g)[:, None] > 1e-12 * size
-        if np.any(removed & (d[None, :] < -tol)):
+        # a plane may remove only what is outside the solid (not so at a re-entrant corner),
+        # looked at on the vertices and on points spread over the polygon (the solid can
+        # cross it with no vertex in it)
+        from .clipping import polygon_samples
+        smp, ok = polygon_samples(poly[None], np.array([len(poly)]))
+        pts = np.concatenate([poly, smp[0][ok[0]]])
+        dp = np.concatenate([d, np.asarray(container.sdf(smp[0][ok[0]]), float)])
+        removed = np.einsum("vk,pk->pv", pts, g) - np.einsum("pk,pk->p", feet, g)[:, None] > 1e-12 * size
+        if np.any(removed & (dp[None, :] < -tol)):
             return sampled_area(poly, normal, container)
         for foot, nrm in zip(feet, g):
             poly = clip_polygon(poly, foot, nrm)
@@ -191,7 +197,11 @@ def sampled_boundary(hs, guess, container, k=48, bin_width=0.35):
     inside the surface, grouped by their outward normal (bins of ``bin_width`` in each
     component). Each group's area is its shell volume / eps (the coarea formula, ``|grad sdf|``
     = 1), its normal the mean gradient, its point the mean of the points moved onto the
-    surface. Returns (areas, normals, points), each (f, ...)."""
+    surface. Along a re-entrant edge the inner level sets are rounded: the faces there come out
+    high by about pi/4 eps per unit length of edge (a notch floor of 0.8 x 2 mm at 600
+    elements: +1 to +4 %); a shell on both sides cancels that but loses as much at the convex
+    edges of a hole's ends, which the surface-area test holds to 0.5 %. Returns (areas,
+    normals, points), each (f, ...)."""
     from scipy.spatial import HalfspaceIntersection
     empty = (np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)))
     x0 = interior_point(hs, guess)

@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .cell_clipping import cell_halfspaces, clipped_area, clipped_volume, sampled_boundary
+from .cell_clipping import (cell_halfspaces, clip_polygon, clipped_area, clipped_volume, order_polygon,
+                            sampled_boundary)
 from .ghosts import ghost_points, tessellate_with_ghosts
 
 __all__ = ["BoundedCells", "_piece_planes", "_protrusion_integral", "bounded_cells"]
@@ -102,6 +103,54 @@ def _protrusion_integral(verts, count, centre, container, signed=True):
     return np.where(valid, tri, 0.0).sum(axis=1)
 
 
+def _tessellation_without_gaps(pos, radius, ghosts, normals, container, bounds, r_max, tol, max_rounds: int = 4,
+                               edge_cos: float = 0.866):
+    """The tessellation of the elements with their ghosts, less the ghosts whose cell reaches
+    into the solid beyond a re-entrant edge: (points, Tessellation, ghosts kept).
+
+    A ghost's mirror plane is a supporting plane of the solid only near its element. Near a
+    re-entrant edge (a notch) the ghost of an element on one face can be nearer to solid
+    beyond the other face than any element is: that solid would then belong to no cell (a
+    gap in the faces between elements: 1-3.5 % of a 0.2 mm ligament's section near its
+    entrance at 10,000 elements). Points of the ghost's cell are looked at (its vertices and
+    points spread over its faces with elements); one inside the solid by more than ``tol``
+    [m] whose surface normal turns from the ghost's mirror normal by more than 30 degrees
+    (``edge_cos``) is beyond an edge: the ghost is dropped and the rest tessellated again (its
+    element's cell is then clipped by the container instead), round after round. The sag of a
+    smoothly curved concave wall under the mirror planes (a hole's) turns the normal less and
+    is left as it was."""
+    from .clipping import polygon_samples
+    n = pos.shape[0]
+    for _ in range(max_rounds):
+        pts, tess = tessellate_with_ghosts(pos, radius, ghosts, bounds, r_max)
+        ng = ghosts.shape[0]
+        # (point, ghost) candidates: the cells' vertices, and points over the ghost-element faces
+        vin = np.flatnonzero(np.asarray(container.sdf(tess.vertices), float) < -tol)
+        sv = tess.simplices[vin]
+        gm = (sv >= n) & (sv < n + ng)
+        cand_x = [np.repeat(tess.vertices[vin], gm.sum(axis=1), axis=0)]
+        cand_g = [sv[gm] - n]
+        rp = tess.ridge_points
+        rows = np.flatnonzero((rp[:, 0] < n) & (rp[:, 1] >= n) & (rp[:, 1] < n + ng))
+        if rows.size:
+            samples, ok = polygon_samples(*tess.polygons(rows))
+            d = np.full(ok.shape, np.inf)
+            d[ok] = np.asarray(container.sdf(samples[ok]), float)
+            hit = d < -tol
+            cand_x.append(samples[hit])
+            cand_g.append(np.broadcast_to((rp[rows, 1] - n)[:, None], hit.shape)[hit])
+        x, g = np.concatenate(cand_x), np.concatenate(cand_g)
+        bad = np.zeros(0, np.int64)
+        if g.size:
+            nx = np.asarray(container.gradient(x), float)
+            nx /= np.maximum(np.linalg.norm(nx, axis=1), 1e-300)[:, None]
+            bad = np.unique(g[np.einsum("ij,ij->i", nx, normals[g]) < edge_cos])
+        if not bad.size:
+            break
+        ghosts, normals = np.delete(ghosts, bad, axis=0), np.delete(normals, bad, axis=0)
+    return pts, tess, ghosts
+
+
 def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
                   planes_per_round: int = 2, radius_range=None, bounds=None) -> BoundedCells:
     """Voronoi cells of the element centres bounded by the container: faces, volumes and
@@ -132,16 +181,16 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     -------
     BoundedCells
     """
-    from .clipping import FaceSet, clip, concat, face_areas, order_polygons, volumes
+    from .clipping import FaceSet, clip, concat, face_areas, order_polygons, polygon_samples, volumes
     pos = np.asarray(pos, float)
     radius = np.asarray(radius, float)
     n = pos.shape[0]
     r_min, r_max = (float(np.min(radius)), float(np.max(radius))) if radius_range is None else map(float, radius_range)
-    ghosts, _, _, _ = ghost_points(pos, radius, container, band=4.0 * r_max)
-    pts, tess = tessellate_with_ghosts(pos, radius, ghosts, bounds, r_max)
+    ghosts, _, g_normal, _ = ghost_points(pos, radius, container, band=4.0 * r_max)
+    tol0 = rel_tol * 2.0 * r_min
+    pts, tess, ghosts = _tessellation_without_gaps(pos, radius, ghosts, g_normal, container, bounds, r_max, tol0)
     n_real_and_ghosts = n + ghosts.shape[0]
     rp = tess.ridge_points
-    tol0 = rel_tol * 2.0 * r_min
     vout = np.asarray(container.sdf(tess.vertices), float) > tol0
     flagged = tess.cells_touching(vout)
     flagged[n:] = False
@@ -265,6 +314,15 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
                 chk = act[fo] & (d < tol_in[fo])
                 s_chk = np.einsum("vk,vk->v", fv[chk] - point[fo[chk]], normal[fo[chk]])
                 bad = np.unique(fo[chk][s_chk > 1e-12 * size[fo[chk]]])
+                # and points spread over the faces: the solid can cross a face with no vertex in it
+                fm = act[faces.owner]
+                smp, sok = polygon_samples(faces.verts[fm], faces.count[fm])
+                so = np.broadcast_to(faces.owner[fm][:, None], sok.shape)[sok]
+                smp = smp[sok]
+                cut = np.einsum("vk,vk->v", smp - point[so], normal[so]) > 1e-12 * size[so]
+                if np.any(cut):
+                    inner = np.asarray(container.sdf(smp[cut]), float) < tol_in[so[cut]]
+                    bad = np.union1d(bad, so[cut][inner])
                 if bad.size:
                     sampled[cells[bad]] = True
                     active[bad] = False
@@ -310,7 +368,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
             both = ~plain & (cnts > 0)
             area[both] = sums[both] / cnts[both]
         # sampled (re-entrant) cells: the per-cell path
-        s_faces = []
+        s_faces, boxes = [], {}
         for i in np.flatnonzero(sampled):
             nb = np.concatenate([rp[rp[:, 0] == i, 1], rp[rp[:, 1] == i, 0]])
             # the cell, within a box of 3 median neighbour distances around the element (its
@@ -320,6 +378,7 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
                 else 4.0 * float(radius[i])
             box = np.column_stack([np.vstack([np.eye(3), -np.eye(3)]),
                                    np.concatenate([-(pos[i] + half), pos[i] - half])])
+            boxes[i] = box
             hs = np.vstack([cell_halfspaces(pts, i, nb), box])
             vol[i] = clipped_volume(hs, pos[i].copy(), container, max_rounds, rel_tol)
             # its boundary faces, by sampling too
@@ -334,7 +393,14 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
             redo = ~plain & (sampled[pairs[:, 0]] | sampled[pairs[:, 1]])
             for m in np.flatnonzero(redo):
                 dn = pts[pairs[m, 1]] - pts[pairs[m, 0]]
-                area[m] = clipped_area(tess.vertices[tess.ridge(pidx[m])], dn / np.linalg.norm(dn), container)
+                dn /= np.linalg.norm(dn)
+                # the face within its sampled cells' boxes first: with no ghost near a
+                # re-entrant edge a cell may be open to the far points, and its faces with it
+                poly = order_polygon(tess.vertices[tess.ridge(pidx[m])], dn)
+                for k in pairs[m]:
+                    for row in boxes.get(int(k), ()):
+                        poly = clip_polygon(poly, -row[3] * row[:3], row[:3]) if len(poly) >= 3 else poly
+                area[m] = clipped_area(poly, dn, container) if len(poly) >= 3 else 0.0
     # ghost faces of whole cells
     gsel = np.flatnonzero(((rp[:, 0] < n) & whole[rp[:, 0]] & (rp[:, 1] >= n) & (rp[:, 1] < n_real_and_ghosts))
                           | ((rp[:, 1] < n) & whole[rp[:, 1]] & (rp[:, 0] >= n) & (rp[:, 0] < n_real_and_ghosts)))

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FaceSet", "order_polygons", "polygon_vector_area", "clip", "volumes", "concat"]
+__all__ = ["polygon_samples", "FaceSet", "order_polygons", "polygon_vector_area", "clip", "volumes", "concat"]
 
 
 @dataclass
@@ -47,6 +47,25 @@ class FaceSet:
 
 def _valid(count, P):
     return np.arange(P)[None, :] < count[:, None]
+
+
+def polygon_samples(verts, count):
+    """Points spread over each padded, cyclically ordered polygon (F, P, 3) with ``count``
+    vertices: its fan triangles' centroids, its edges' midpoints and the midpoints between
+    its centre and its vertices; (F, 3 P, 3) and a (F, 3 P) mask of the real ones. What a
+    check of "does a plane or a cell reach into the solid" looks at besides the vertices: at a
+    re-entrant edge the solid can cross a face with no vertex in it."""
+    verts = np.asarray(verts, float)
+    count = np.asarray(count)
+    P = verts.shape[1]
+    valid = _valid(count, P)
+    cen = np.where(valid[:, :, None], verts, 0.0).sum(axis=1) / np.maximum(count, 1)[:, None]
+    nxt = np.where((np.arange(P)[None, :] + 1 < count[:, None])[:, :, None], np.roll(verts, -1, axis=1),
+                   verts[:, :1])
+    samples = np.concatenate([(cen[:, None] + verts + nxt) / 3.0, 0.5 * (verts + nxt), 0.5 * (cen[:, None] + verts)],
+                             axis=1)
+    ok = np.concatenate([valid, valid, valid], axis=1) & (count >= 3)[:, None]
+    return samples, ok
 
 
 def order_polygons(verts, count, normal):

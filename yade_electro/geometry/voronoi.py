@@ -22,7 +22,8 @@ Cracks (:meth:`VoronoiFaces.cracked`, the ``voronoi`` law's ``crack='facets'``):
 surface is the union of the broken bonds' own Voronoi faces (their *facets*). A pair bonded in
 the reference configuration conducts while its bond is intact. A pair that never was bonded
 (a Voronoi neighbour without a bond) conducts while its elements are linked by at most
-``hops`` intact bonds and the segment between them crosses no broken facet: the point where
+``hops`` intact bonds, or by no more than in the reference when they were farther apart
+there (a thin part), and the segment between them crosses no broken facet: the point where
 it crosses a broken pair's bisector plane is on that pair's face when no element centre is
 nearer to it than the pair's two. Faces near a crack front whose segments pass beside the
 broken facets keep conducting. Failure modes, measured on a 2 x 2 x 8 mm bar with an edge
@@ -142,8 +143,9 @@ class VoronoiFaces:
         pos = np.clip(np.searchsorted(self.key, k), 0, self.key.size - 1)
         return np.where(self.key[pos] == k, pos, -1)
 
-    def linked(self, bonds, hops: int) -> np.ndarray:
-        """Per face: are its two elements linked by a path of at most ``hops`` of ``bonds``?
+    def linked(self, bonds, hops: int, pairs=None) -> np.ndarray:
+        """Per face (or per row of ``pairs``): are its two elements linked by a path of at
+        most ``hops`` of ``bonds``?
 
         By the compiled breadth-first helper (:func:`yade_electro.native.hops_linked`:
         memory of a few arrays per node; at 1M elements 0.24 s; the tests' reference is the
@@ -155,7 +157,30 @@ class VoronoiFaces:
         sym = sp.csr_matrix((np.ones(2 * len(b), dtype=np.int8),
                              (np.concatenate([b[:, 0], b[:, 1]]), np.concatenate([b[:, 1], b[:, 0]]))),
                             shape=(n, n))
-        return hops_linked(sym.indptr, sym.indices, self.pairs, hops)
+        return hops_linked(sym.indptr, sym.indices, self.pairs if pairs is None else pairs, hops)
+
+    #: the farthest reference hop distance looked up for a pair not linked within ``hops``
+    FAR_HOPS = 12
+
+    def reference_hops(self, reference_bonds, hops: int) -> np.ndarray:
+        """Per face, its two elements' hop distance along ``reference_bonds`` when it exceeds
+        ``hops`` (up to :attr:`FAR_HOPS`; beyond: a large number), else ``hops``. Kept for one
+        reference (the faces are made once per element set)."""
+        ref = np.asarray(reference_bonds, dtype=np.int64).reshape(-1, 2)
+        key = (int(hops), ref.shape[0], hash(ref.tobytes()))
+        if getattr(self, "_ref_hops", None) is not None and self._ref_hops[0] == key:
+            return self._ref_hops[1]
+        dist = np.full(self.pairs.shape[0], int(hops), dtype=np.int64)
+        far = np.flatnonzero(~self.linked(ref, hops))
+        for h in range(int(hops) + 1, self.FAR_HOPS + 1):
+            if not far.size:
+                break
+            got = self.linked(ref, h, self.pairs[far])
+            dist[far[got]] = h
+            far = far[~got]
+        dist[far] = np.iinfo(np.int64).max
+        self._ref_hops = (key, dist)
+        return dist
 
     def supported_pairs(self, bonds, hops: int = 2) -> np.ndarray:
         """The Voronoi pairs that conduct given the bonds: those whose two elements are linked
@@ -183,7 +208,16 @@ class VoronoiFaces:
         was_bond = np.zeros(self.pairs.shape[0], bool)
         at = self.index_of(ref)
         was_bond[at[at >= 0]] = True
-        keep = np.where(was_bond, False, self.linked(b, hops))
+        # an unbonded pair conducts while its elements are as near along intact bonds as they
+        # were in the reference, or within ``hops``: in a thin part (a ligament two elements
+        # wide) faces of pairs farther apart than ``hops`` are solid too, and a 0.2 mm
+        # ligament lost up to 1.2 % of its section when they did not conduct
+        dist = self.reference_hops(ref, hops)
+        keep = ~was_bond & self.linked(b, hops)
+        farther = ~was_bond & ~keep & (dist > hops)
+        for h in np.unique(dist[farther]):
+            sel = np.flatnonzero(farther & (dist == h))
+            keep[sel] = True if h > self.FAR_HOPS else self.linked(b, int(h), self.pairs[sel])
         bi = self.index_of(broken)
         bi = bi[bi >= 0]
         cand = np.flatnonzero(keep)
