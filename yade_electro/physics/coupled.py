@@ -345,8 +345,7 @@ class ElectroThermalModel:
         log.debug("electro-thermal model rebuilt on a graph of %d nodes, %d edges (dt_crit %.3g s)",
                   graph.n_nodes, self.network.edges.shape[0], self.heat.critical_time_step)
 
-    _T_restore = None
-    _prepared = None
+    _T_restore = _prepared = None
     _materials_changed = False
 
     def _volumes(self, graph):
@@ -438,7 +437,8 @@ class ElectroThermalModel:
             self.solution = sol
             self._sol_id = sol
             self.n_potential_solves += 1
-            self.sources = el.element_joule_power(self.eta)
+            vol = self._volumes(self._prepared) if self.integrator.joule_sharing == "cells" else None
+            self.sources = el.element_joule_power(self.eta, self.integrator.joule_sharing, vol)
         return self.sources
 
     # -- stepping ----------------------------------------------------------------------------

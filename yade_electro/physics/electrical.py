@@ -272,9 +272,11 @@ class ElectricalModel:
         cells (element, electrode node); the solution's ``branch_current`` follows them."""
         return self.problem.edges
 
-    def element_joule_power(self, eta: float = 1.0) -> np.ndarray:
+    def element_joule_power(self, eta: float = 1.0, sharing: str = "edges", volume=None) -> np.ndarray:
         """Joule heat [W] per element: each network edge's eta w^2 / c shared half and half by
-        its ends, a surface half cell's given to its element."""
+        its ends, a surface half cell's given to its element (``sharing='edges'``); or, with
+        ``sharing='cells'`` and the elements' ``volume`` [m^3], that total given by the field
+        over each cell (:func:`~yade_electro.physics.thermal.cell_joule_sources`)."""
         from ..network.kirchhoff import edge_power
         n, m = self.n_elements, self.network.edges.shape[0]
         p = eta * edge_power(self.solution.branch_current, self.conductance)
@@ -282,6 +284,10 @@ class ElectricalModel:
         out = 0.5 * (np.bincount(e[:, 0], p[:m], n) + np.bincount(e[:, 1], p[:m], n))
         if self._surface_edges.size:
             out += np.bincount(self._surface_edges[:, 0], p[m:], n)
+        if sharing == "cells":
+            from .thermal import cell_joule_sources
+            out = cell_joule_sources(self.bond_graph.pos, e[self.conductance[:m] > 0], self.solution.potential,
+                                     volume, self._resistivity_of(n), out)
         return out
 
     def _resistivity_of(self, n):

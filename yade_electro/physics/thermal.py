@@ -37,7 +37,7 @@ from ..network.heat_conditions import ThermalWall
 from ..network.kirchhoff import edge_power
 from ..network.transient import HeatSolver
 
-__all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources",
+__all__ = ["heat_capacity", "thermal_conductance", "diffusion_time_step", "edge_joule_power", "joule_sources", "cell_joule_sources",
            "electrical_power", "heat_solver_on_graph", "heat_material", "split_heat_boundaries", "surface_conditions",
            "source_power"]
 
@@ -136,6 +136,43 @@ def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float =
     if p.shape[0] != edges.shape[0]:
         raise ValueError(f"one branch current per edge expected ({edges.shape[0]}), got {p.shape[0]}")
     return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
+
+
+def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources) -> np.ndarray:
+    """Joule power per element [W] from the field over its cell: ``V_i |g_i|^2 / rho_i``, with
+    ``g_i`` [V/m] the least-squares gradient of the node ``potential`` [V] over the element's
+    neighbours along ``edges`` (weights 1 / l^2; exact for a uniform field), ``volume`` [m^3]
+    and ``resistivity`` [ohm m] per element, then scaled so the total is that of
+    ``edge_sources`` [W] (the network's power, e.g. :func:`joule_sources`). An element whose
+    neighbours do not span three dimensions (fewer than three directions) keeps its value of
+    ``edge_sources``, and the rest are scaled to what remains. Elements with no power in
+    ``edge_sources`` (floating parts) get none."""
+    pos = np.asarray(pos, float)
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    n = pos.shape[0]
+    u = np.asarray(potential, float)[:n]
+    p_edge = np.asarray(edge_sources, float)
+    d = pos[e[:, 1]] - pos[e[:, 0]]
+    w = 1.0 / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+    du = u[e[:, 1]] - u[e[:, 0]]
+    M = np.zeros((n, 3, 3))
+    b = np.zeros((n, 3))
+    for a in range(3):                         # both ends: d and du change sign together
+        b[:, a] = np.bincount(e[:, 0], w * du * d[:, a], n) + np.bincount(e[:, 1], w * du * d[:, a], n)
+        for c in range(a, 3):
+            m = np.bincount(e[:, 0], w * d[:, a] * d[:, c], n) + np.bincount(e[:, 1], w * d[:, a] * d[:, c], n)
+            M[:, a, c] = M[:, c, a] = m
+    eig = np.linalg.eigvalsh(M)                # (n, 3) ascending; the weights make M dimensionless
+    ok = (eig[:, 0] > 1e-6 * np.maximum(eig[:, 2], 1e-300)) & (p_edge > 0)
+    g = np.zeros((n, 3))
+    g[ok] = np.linalg.solve(M[ok], b[ok][:, :, None])[:, :, 0]
+    rho = np.broadcast_to(np.asarray(resistivity, float), (n,))
+    p = np.where(ok, np.asarray(volume, float) * np.einsum("ij,ij->i", g, g) / rho, 0.0)
+    rest = float(p_edge[ok].sum())
+    total = float(p.sum())
+    out = p_edge.copy()
+    out[ok] = p[ok] * (rest / total) if total > 0 else p_edge[ok]
+    return out
 
 
 def electrical_power(solution) -> float:

@@ -370,9 +370,11 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
 
     def _distributed_calls(self, graph):
         t, c = self._thermal, self._coupled
-        if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id:
+        if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id or \
+                c.integrator.joule_sharing != "edges":
             raise BoundaryConditionError("a distributed run (solver='petsc' under mpiexec) does not do steady states, "
-                                         "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
+                                         "overlapped calls, coupling iterations, Integrator(joule_sharing='cells') "
+                                         "or InitialTemperature(by_id=...) yet")
         refuse_clumps(self.reader)
         specs = self.model.specs if self.model is not None else ()
         ids = self._electrode_ids(graph)
