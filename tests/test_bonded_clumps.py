@@ -61,5 +61,7 @@ def test_clumps_in_a_bonded_rod(run_yade_script):
     assert lu["R_vs_plain"] < 1e-12 and 0.01 < lu["T_vs_plain"] < 5.0, out   # lumped: one T per clump
     assert lu["members_T"][0] == lu["members_T"][1] and abs(lu["clump_T"] - lu["members_T"][0]) < 1e-9, out
     assert min(r["members_T"]) <= r["clump_T"] <= max(r["members_T"]), out
-    assert none["n"] == 280 and none["R_vs_plain"] > 0.01, out                # left out: 120 members
+    # left out: 120 members; the 280 others' Voronoi cells fill the container, so R_eq barely
+    # moves (0.02 %; +3.1 % while faces of pairs more than 3 bonds apart did not conduct)
+    assert none["n"] == 280 and 0.0 < none["R_vs_plain"] < 0.01 and none["T_vs_plain"] > 0.01, out
     assert "are left out" in res.stdout + res.stderr
