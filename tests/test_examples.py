@@ -25,8 +25,10 @@ def test_electrical_engine(run_yade_script):
     out = run_yade_script(EXAMPLES / "electrical_engine.py", check=True).result
     assert out["I_top"] == pytest.approx(-out["I_bottom"], rel=1e-9)          # the current is conserved
     assert out["I_top"] * out["R_eq"] == pytest.approx(1.0, rel=1e-9)          # Ohm: 1 V across the rod
-    # a packing cut from a periodic cell is loose at the wall: R_eq a few per cent above nominal
-    assert 0.0 < out["R_eq"] / out["R_nominal"] - 1.0 < 0.10
+    # a packing cut from a periodic cell is loose at the wall, but the Voronoi cells fill the
+    # rod: R_eq -0.05 % from nominal (it was a few per cent high while faces of pairs more than
+    # three bonds apart, common where the packing is loose, did not conduct: issue 36)
+    assert abs(out["R_eq"] / out["R_nominal"] - 1.0) < 0.01
     assert 0.0 <= out["V_body0"] <= 1.0 and out["history_rows"] >= 2
 
 
