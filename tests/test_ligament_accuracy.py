@@ -7,6 +7,7 @@ import pytest
 from yade_electro.core.graph import ContactGraph
 from yade_electro.geometry.cells import bounded_cells
 from yade_electro.geometry.shapes import Box
+from yade_electro.geometry.voronoi import VoronoiFaces
 from yade_electro.laws.factors import make_law
 from yade_electro.packing.dense import dense_packing
 from yade_electro.physics.integrator import Integrator
@@ -96,3 +97,18 @@ def test_cells_joule_sharing_is_exact_in_a_uniform_field(ligament):
     np.testing.assert_array_equal(got, [1.0, 1.0])
     with pytest.raises(ValueError, match="joule_sharing must be 'edges'"):
         Integrator(joule_sharing="faces")
+
+
+def test_far_pairs_stop_conducting_once_a_crack_cuts_the_part_in_two():
+    """A face whose elements are linked only by a long way round (20 bonds, beyond FAR_HOPS)
+    conducts while the bonds link them at all, and stops once one bond on that way breaks (a
+    separated bar carries no current through such faces); an element that never had a bond is
+    not held to the rule (the facet test alone: here, no facets)."""
+    chain = np.column_stack([np.arange(20), np.arange(1, 21)])
+    faces = VoronoiFaces(np.array([[0, 20], [5, 21]]), np.ones(2), 22)
+    pos = np.zeros((22, 3))
+    key = {tuple(p) for p in faces.cracked(pos, chain, chain)}
+    assert {(0, 20), (5, 21)} <= key
+    cut = np.delete(chain, 10, axis=0)
+    key = {tuple(p) for p in faces.cracked(pos, cut, chain)}
+    assert (0, 20) not in key and (5, 21) in key and (10, 11) not in key

@@ -23,7 +23,9 @@ surface is the union of the broken bonds' own Voronoi faces (their *facets*). A 
 the reference configuration conducts while its bond is intact. A pair that never was bonded
 (a Voronoi neighbour without a bond) conducts while its elements are linked by at most
 ``hops`` intact bonds, or by no more than in the reference when they were farther apart
-there (a thin part), and the segment between them crosses no broken facet: the point where
+there (a thin part; beyond 12 bonds: while the intact bonds link them at all; a pair no bond
+linked in the reference, an element that never had a bond, is not held to this), and the
+segment between them crosses no broken facet: the point where
 it crosses a broken pair's bisector plane is on that pair's face when no element centre is
 nearer to it than the pair's two. Faces near a crack front whose segments pass beside the
 broken facets keep conducting. Failure modes, measured on a 2 x 2 x 8 mm bar with an edge
@@ -49,6 +51,16 @@ from .cell_clipping import clipped_by_planes
 from .ghosts import ghost_points, tessellate_with_ghosts
 
 __all__ = ["voronoi_faces", "VoronoiFaces", "voronoi_cell_volumes", "cell_volume_of"]
+
+
+def _same_part(bonds, n: int, pairs) -> np.ndarray:
+    """Per row of ``pairs``: are its two elements in one connected part of ``bonds``?"""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    b = np.asarray(bonds, dtype=np.int64).reshape(-1, 2)
+    adj = sp.coo_matrix((np.ones(len(b), dtype=np.int8), (b[:, 0], b[:, 1])), shape=(n, n))
+    label = connected_components(adj, directed=False)[1]
+    return label[pairs[:, 0]] == label[pairs[:, 1]]
 
 
 def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
@@ -162,10 +174,17 @@ class VoronoiFaces:
     #: the farthest reference hop distance looked up for a pair not linked within ``hops``
     FAR_HOPS = 12
 
+    #: :meth:`reference_hops` of a pair linked in the reference only by more than FAR_HOPS bonds
+    FAR = FAR_HOPS + 1
+    #: :meth:`reference_hops` of a pair not linked at all in the reference (an element that
+    #: never had a bond)
+    UNLINKED = np.iinfo(np.int64).max
+
     def reference_hops(self, reference_bonds, hops: int) -> np.ndarray:
         """Per face, its two elements' hop distance along ``reference_bonds`` when it exceeds
-        ``hops`` (up to :attr:`FAR_HOPS`; beyond: a large number), else ``hops``. Kept for one
-        reference (the faces are made once per element set)."""
+        ``hops`` (up to :attr:`FAR_HOPS`; beyond: :attr:`FAR` when the reference bonds link
+        them at all, else :attr:`UNLINKED`), else ``hops``. Kept for one reference (the faces
+        are made once per element set)."""
         ref = np.asarray(reference_bonds, dtype=np.int64).reshape(-1, 2)
         key = (int(hops), ref.shape[0], hash(ref.tobytes()))
         if getattr(self, "_ref_hops", None) is not None and self._ref_hops[0] == key:
@@ -178,7 +197,9 @@ class VoronoiFaces:
             got = self.linked(ref, h, self.pairs[far])
             dist[far[got]] = h
             far = far[~got]
-        dist[far] = np.iinfo(np.int64).max
+        if far.size:
+            same = _same_part(ref, self.n, self.pairs[far])
+            dist[far] = np.where(same, self.FAR, self.UNLINKED)
         self._ref_hops = (key, dist)
         return dist
 
@@ -215,9 +236,16 @@ class VoronoiFaces:
         dist = self.reference_hops(ref, hops)
         keep = ~was_bond & self.linked(b, hops)
         farther = ~was_bond & ~keep & (dist > hops)
+        # beyond FAR_HOPS: while the intact bonds still link them at all (not once a crack has
+        # cut the part in two); a pair no bond linked in the reference: the facet test alone
         for h in np.unique(dist[farther]):
             sel = np.flatnonzero(farther & (dist == h))
-            keep[sel] = True if h > self.FAR_HOPS else self.linked(b, int(h), self.pairs[sel])
+            if h == self.UNLINKED:
+                keep[sel] = True
+            elif h == self.FAR:
+                keep[sel] = _same_part(b, n, self.pairs[sel])
+            else:
+                keep[sel] = self.linked(b, int(h), self.pairs[sel])
         bi = self.index_of(broken)
         bi = bi[bi >= 0]
         cand = np.flatnonzero(keep)
