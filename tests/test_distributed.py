@@ -117,6 +117,22 @@ except BoundaryConditionError as exc:
 """
 
 
+CELLS_SHARING_SCRIPT = BAD_SCRIPT.replace("import ElectricalEngine,", "import ElectroThermalEngine, Integrator, FixedTemperature,").replace(
+    """    ElectricalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], current=1.0),
+                                 Electrode("b", select=ids[z > 6.5], current=-1.0)], **kw)""",
+    """    kw["material"] = Material(resistivity=1e-6, density=7900.0, specific_heat=500.0, conductivity=16.2)
+    ElectroThermalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], potential=1.0),
+                                     Electrode("b", select=ids[z > 6.5], potential=0.0),
+                                     FixedTemperature("cold", nodes=ids[z < 0.5], temperature=300.0)],
+                         temperature=300.0, integrator=Integrator(dt=1e-3, joule_sharing="cells"), **kw)""")
+
+
+def test_cells_joule_sharing_is_refused_in_a_distributed_run_when_built(yade_exe, tmp_path):
+    assert "joule_sharing=\"cells\"" in CELLS_SHARING_SCRIPT
+    out = _refused_on_both_ranks(yade_exe, tmp_path, CELLS_SHARING_SCRIPT)
+    assert out.count("Integrator(joule_sharing='cells')") == 2, out
+
+
 def test_voronoi_law_is_refused_with_yade_mpy_when_built(yade_exe, tmp_path):
     out = _refused_on_both_ranks(yade_exe, tmp_path, MPY_VORONOI_SCRIPT)
     assert out.count("imports yade.mpy") == 2 and "law='continuum' under mp.mpirun" in out
