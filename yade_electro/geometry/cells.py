@@ -106,7 +106,8 @@ def _protrusion_integral(verts, count, centre, container, signed=True):
 def _tessellation_without_gaps(pos, radius, ghosts, normals, container, bounds, r_max, tol, max_rounds: int = 4,
                                edge_cos: float = 0.866):
     """The tessellation of the elements with their ghosts, less the ghosts whose cell reaches
-    into the solid beyond a re-entrant edge: (points, Tessellation, ghosts kept).
+    into the solid beyond a re-entrant edge: (points, Tessellation, ghosts kept, the
+    container's sdf at its vertices [m]).
 
     A ghost's mirror plane is a supporting plane of the solid only near its element. Near a
     re-entrant edge (a notch) the ghost of an element on one face can be nearer to solid
@@ -121,11 +122,14 @@ def _tessellation_without_gaps(pos, radius, ghosts, normals, container, bounds, 
     is left as it was."""
     from .clipping import polygon_samples
     n = pos.shape[0]
-    for _ in range(max_rounds):
+    for round_ in range(max_rounds):
         pts, tess = tessellate_with_ghosts(pos, radius, ghosts, bounds, r_max)
         ng = ghosts.shape[0]
+        sdf_v = np.asarray(container.sdf(tess.vertices), float)
+        if round_ == max_rounds - 1:
+            break                   # the ghosts of the tessellation returned, whatever is left
         # (point, ghost) candidates: the cells' vertices, and points over the ghost-element faces
-        vin = np.flatnonzero(np.asarray(container.sdf(tess.vertices), float) < -tol)
+        vin = np.flatnonzero(sdf_v < -tol)
         sv = tess.simplices[vin]
         gm = (sv >= n) & (sv < n + ng)
         cand_x = [np.repeat(tess.vertices[vin], gm.sum(axis=1), axis=0)]
@@ -148,7 +152,7 @@ def _tessellation_without_gaps(pos, radius, ghosts, normals, container, bounds, 
         if not bad.size:
             break
         ghosts, normals = np.delete(ghosts, bad, axis=0), np.delete(normals, bad, axis=0)
-    return pts, tess, ghosts
+    return pts, tess, ghosts, sdf_v
 
 
 def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int = 4,
@@ -188,10 +192,11 @@ def bounded_cells(pos, radius, container, rel_tol: float = 3e-3, max_rounds: int
     r_min, r_max = (float(np.min(radius)), float(np.max(radius))) if radius_range is None else map(float, radius_range)
     ghosts, _, g_normal, _ = ghost_points(pos, radius, container, band=4.0 * r_max)
     tol0 = rel_tol * 2.0 * r_min
-    pts, tess, ghosts = _tessellation_without_gaps(pos, radius, ghosts, g_normal, container, bounds, r_max, tol0)
+    pts, tess, ghosts, sdf_v = _tessellation_without_gaps(pos, radius, ghosts, g_normal, container, bounds, r_max,
+                                                          tol0)
     n_real_and_ghosts = n + ghosts.shape[0]
     rp = tess.ridge_points
-    vout = np.asarray(container.sdf(tess.vertices), float) > tol0
+    vout = sdf_v > tol0
     flagged = tess.cells_touching(vout)
     flagged[n:] = False
     real_pair = (rp[:, 0] < n) & (rp[:, 1] < n)
