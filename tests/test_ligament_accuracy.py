@@ -112,3 +112,16 @@ def test_far_pairs_stop_conducting_once_a_crack_cuts_the_part_in_two():
     cut = np.delete(chain, 10, axis=0)
     key = {tuple(p) for p in faces.cracked(pos, cut, chain)}
     assert (0, 20) not in key and (5, 21) in key and (10, 11) not in key
+
+
+def test_an_element_that_never_had_a_bond_does_not_bridge_a_crack():
+    """A rattler between two parts of a chain conducts with both while the chain is intact; once
+    the bond between the parts breaks it conducts with the part it has most face area with
+    only (it bridged the separated halves of a cracked bar: R_eq finite where it is infinite)."""
+    chain = np.column_stack([np.arange(9), np.arange(1, 10)])
+    faces = VoronoiFaces(np.array([[3, 10], [6, 10]]), np.array([1.0, 2.0]), 11)
+    pos = np.zeros((11, 3))
+    key = {tuple(p) for p in faces.cracked(pos, chain, chain)}
+    assert {(3, 10), (6, 10)} <= key
+    key = {tuple(p) for p in faces.cracked(pos, np.delete(chain, 4, axis=0), chain)}
+    assert (6, 10) in key and (3, 10) not in key

@@ -23,8 +23,9 @@ surface is the union of the broken bonds' own Voronoi faces (their *facets*). A 
 the reference configuration conducts while its bond is intact. A pair that never was bonded
 (a Voronoi neighbour without a bond) conducts while its elements are linked by at most
 ``hops`` intact bonds, or by no more than in the reference when they were farther apart
-there (a thin part; beyond 12 bonds: while the intact bonds link them at all; a pair no bond
-linked in the reference, an element that never had a bond, is not held to this), and the
+there (a thin part; beyond 12 bonds: while the intact bonds link them at all; an element that
+never had a bond conducts with its neighbours in one part of the intact bonds, the one it has
+most face area with, so that it cannot bridge a crack that cut the solid in two), and the
 segment between them crosses no broken facet: the point where
 it crosses a broken pair's bisector plane is on that pair's face when no element centre is
 nearer to it than the pair's two. Faces near a crack front whose segments pass beside the
@@ -212,6 +213,38 @@ class VoronoiFaces:
         key = np.unique(out[:, 0] * self.n + out[:, 1])  # np.unique(out, axis=0), by one int64 key
         return np.column_stack([key // self.n, key % self.n])
 
+    def _lone_faces_kept(self, sel, ref, bonds) -> np.ndarray:
+        """Which of the faces ``sel`` (pairs no reference bond linked) conduct: between elements
+        that both had bonds, all; an element that never had a bond (a rattler, inside the
+        solid) conducts with the neighbours of one part of the intact ``bonds`` only, the part
+        its faces with bonded neighbours have most area with, so that it cannot bridge a crack
+        that has cut the solid in two (in an intact solid that is every neighbour)."""
+        from scipy.sparse.csgraph import connected_components
+        import scipy.sparse as sp
+        n = self.n
+        lone = np.bincount(ref.ravel(), minlength=n) == 0
+        i, j = self.pairs[sel, 0], self.pairs[sel, 1]
+        if not (lone[i] | lone[j]).any():
+            return np.ones(sel.size, bool)
+        adj = sp.coo_matrix((np.ones(len(bonds), dtype=np.int8), (bonds[:, 0], bonds[:, 1])), shape=(n, n))
+        label = connected_components(adj, directed=False)[1]
+        one = lone[i] ^ lone[j]
+        k = np.where(lone[i], i, j)[one]
+        m = np.where(lone[i], j, i)[one]
+        chosen = np.full(n, -1, dtype=np.int64)
+        if k.size:
+            keys, inv = np.unique(k * n + label[m], return_inverse=True)
+            total = np.bincount(inv, weights=self.area[sel[one]])
+            kk, ll = keys // n, keys % n
+            order = np.lexsort((-total, kk))
+            first = order[np.r_[True, kk[order][1:] != kk[order][:-1]]]
+            chosen[kk[first]] = ll[first]
+        keep = np.ones(sel.size, bool)
+        keep[one] = label[m] == chosen[k]
+        both = lone[i] & lone[j]
+        keep[both] = chosen[i[both]] == chosen[j[both]]
+        return keep
+
     def cracked(self, pos, bonds, reference_bonds, hops: int = 3) -> np.ndarray:
         """The Voronoi pairs that conduct after the bonds ``reference_bonds - bonds`` broke, by
         the crack-facet rule (see the module doc): a pair bonded in the reference conducts while
@@ -241,7 +274,7 @@ class VoronoiFaces:
         for h in np.unique(dist[farther]):
             sel = np.flatnonzero(farther & (dist == h))
             if h == self.UNLINKED:
-                keep[sel] = True
+                keep[sel] = self._lone_faces_kept(sel, ref, b)
             elif h == self.FAR:
                 keep[sel] = _same_part(b, n, self.pairs[sel])
             else:
