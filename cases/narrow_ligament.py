@@ -34,6 +34,7 @@ reads low against any cell average, by an amount that shrinks as the cells do.
 Run
 ---
     yade-electro -n -x cases/narrow_ligament.py [--n 10000] [--seeds 1,2,3,4] [--quick]
+    yade-electro -n -x cases/narrow_ligament.py --notch-depth 0.3e-3   # notched_joule's 0.5 mm ligament
 
 Ends with one JSON line.
 """
@@ -61,42 +62,43 @@ T0, VOLTAGE, DT = 293.15, 1.0, 5e-5                     # K, V, s
 CENTRE = np.array([0.5 * LENGTH, 0.5 * WIDTH, 0.5 * THICKNESS])
 
 
-def shape():
+def shape(depth: float = NOTCH_DEPTH):
+    """The notched bar, notches ``depth`` [m] deep from each side (the ligament: WIDTH - 2 depth)."""
     from yade_electro.geometry.shapes import Box
     a, b = 0.5 * (LENGTH - NOTCH_WIDTH), 0.5 * (LENGTH + NOTCH_WIDTH)
-    L, B, Z, D = LENGTH, WIDTH, THICKNESS, NOTCH_DEPTH
+    L, B, Z, D = LENGTH, WIDTH, THICKNESS, depth
     return (Box((0, 0, 0), (L, B, Z)) - Box((a, -B, -Z), (b, D, 2 * Z)) - Box((a, B - D, -Z), (b, 2 * B, 2 * Z)))
 
 
-def fem_geometry():
+def fem_geometry(depth: float = NOTCH_DEPTH):
     from yade_electro.fem import NotchedBarGeometry
     return NotchedBarGeometry(length=LENGTH, width=WIDTH, thickness=THICKNESS, notch_width=NOTCH_WIDTH,
-                              notch_depth=NOTCH_DEPTH, kind="rect", sides="both")
+                              notch_depth=depth, kind="rect", sides="both")
 
 
-def fem_run(h: float, t_end: float, probes):
+def fem_run(h: float, t_end: float, probes, depth: float = NOTCH_DEPTH):
     """One FEM run: (R_eq [ohm], recorded times [s], probe temperatures (nrec, npts) [K])."""
     from yade_electro import fem
-    g = fem_geometry()
+    g = fem_geometry(depth)
     mesh = fem.notched_bar_mesh(g, h, 0.5, 1)
     res = fem.joule_heating(mesh, RHO_E, CONDUCTIVITY, DENSITY * SPECIFIC_HEAT, {"end1": VOLTAGE, "end0": 0.0},
                             t_end=t_end, dt=DT, theta=0.5, T0=T0, probes=probes)
     return float(res.resistance[0]), np.asarray(res.times), np.asarray(res.probe_temperatures), int(res.basis.N)
 
 
-def cell_samples(centres, radius, k: int, per_cell: int, seed: int = 5):
+def cell_samples(centres, radius, k: int, per_cell: int, seed: int = 5, depth: float = NOTCH_DEPTH):
     """Sample points of the cells of element ``k``: uniform in a box of 2.5 radii around its
     centre, kept when inside the solid and nearer to it than to any other centre."""
     from scipy.spatial import cKDTree
     rng = np.random.default_rng(seed)
     c, r = centres[k], 2.5 * float(radius[k])
     pts = c + rng.uniform(-r, r, size=(40 * per_cell, 3))
-    pts = pts[shape().sdf(pts) < 0]
+    pts = pts[shape(depth).sdf(pts) < 0]
     pts = pts[cKDTree(centres).query(pts)[1] == k]
     return pts[:per_cell]
 
 
-def dem_run(n: int, seed: int, times, cache_dir=None, sharing: str = "edges") -> dict:
+def dem_run(n: int, seed: int, times, cache_dir=None, sharing: str = "edges", depth: float = NOTCH_DEPTH) -> dict:
     """The DEM heating; temperatures of every element at ``times`` [s] and R_eq; ``sharing``: the
     Joule heat's ``Integrator(joule_sharing=...)``."""
     from yade_electro.yade import ElectroThermalEngine, Electrode, Integrator, Law, Material
@@ -104,7 +106,7 @@ def dem_run(n: int, seed: int, times, cache_dir=None, sharing: str = "edges") ->
     from yade_electro.yade.runtime import import_yade
     O = import_yade().Omega()
     O.reset()
-    sh = shape()
+    sh = shape(depth)
     pk = P.dense_packing(sh, n=n, seed=seed, cache_dir=cache_dir)
     P.add_bonded_packing(pk)
     for e in O.engines:
@@ -144,6 +146,8 @@ def main(argv=None) -> dict:
     ap.add_argument("--hs", default="0.05e-3,0.025e-3,0.0125e-3", help="FEM mesh sizes [m], coarse to fine")
     ap.add_argument("--per-cell", type=int, default=400, help="FEM sample points per cell")
     ap.add_argument("--sharing", default="edges,cells", help="Integrator(joule_sharing=...) values, each run")
+    ap.add_argument("--notch-depth", type=float, default=NOTCH_DEPTH,
+                    help="notch depth from each side [m] (0.45e-3: the 0.2 mm ligament; 0.3e-3: notched_joule's 0.5 mm)")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--cache-dir", default=None)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
@@ -157,27 +161,27 @@ def main(argv=None) -> dict:
     for seed in seeds:
         for sharing in args.sharing.split(","):
             sys.stderr.write(f"[narrow_ligament] DEM n={args.n} seed={seed} joule_sharing={sharing}\n")
-            dems.append(dem_run(args.n, seed, times, args.cache_dir, sharing))
+            dems.append(dem_run(args.n, seed, times, args.cache_dir, sharing, args.notch_depth))
     # the FEM: its points are the ligament's centre, each run's nearest element's centre and
     # the samples of that element's cell
     probes, slices = [CENTRE], []
     for d in dems:
         k = int(np.argmin(np.linalg.norm(d["pos"] - CENTRE, axis=1)))
         d["k"] = k
-        samples = cell_samples(d["pos"], d["radius"], k, args.per_cell)
+        samples = cell_samples(d["pos"], d["radius"], k, args.per_cell, depth=args.notch_depth)
         slices.append((len(probes), len(probes) + 1, len(probes) + 1 + len(samples)))
         probes += [d["pos"][k]] + list(samples)
     probes = np.array(probes)
     fem_R, fem_T = [], None
     for h in hs:
         sys.stderr.write(f"[narrow_ligament] FEM h={h:g} m\n")
-        R, t_rec, T_rec, ndofs = fem_run(h, max(times), probes)
+        R, t_rec, T_rec, ndofs = fem_run(h, max(times), probes, args.notch_depth)
         fem_R.append(R)
         fem_T, fem_t, fem_ndofs = T_rec, t_rec, ndofs
     from yade_electro import fem
     R_ref = fem.richardson(hs, fem_R)
     rec = [int(np.argmin(np.abs(fem_t - t))) for t in times]
-    out = {"case": "narrow_ligament", "n": args.n, "seeds": seeds, "times_s": times, "ligament_m": WIDTH - 2 * NOTCH_DEPTH,
+    out = {"case": "narrow_ligament", "n": args.n, "seeds": seeds, "times_s": times, "ligament_m": WIDTH - 2 * args.notch_depth,
            "fem_R_eq_ohm": fem_R, "fem_R_extrapolated_ohm": float(R_ref.extrapolated), "fem_R_gci_ohm": float(R_ref.gci),
            "fem_ndofs": fem_ndofs, "fem_centre_rise_K": (fem_T[rec, 0] - T0).tolist(), "runs": []}
     for d, (i_own, i_cell, i_end) in zip(dems, slices):
