@@ -103,7 +103,7 @@ def test_far_pairs_stop_conducting_once_a_crack_cuts_the_part_in_two():
     """A face whose elements are linked only by a long way round (20 bonds, beyond FAR_HOPS)
     conducts while the bonds link them at all, and stops once one bond on that way breaks (a
     separated bar carries no current through such faces); an element that never had a bond is
-    not held to the rule (the facet test alone: here, no facets)."""
+    not held to the reference distance (it keeps its one neighbour, whose part it is in)."""
     chain = np.column_stack([np.arange(20), np.arange(1, 21)])
     faces = VoronoiFaces(np.array([[0, 20], [5, 21]]), np.ones(2), 22)
     pos = np.zeros((22, 3))

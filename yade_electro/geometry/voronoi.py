@@ -54,14 +54,14 @@ from .ghosts import ghost_points, tessellate_with_ghosts
 __all__ = ["voronoi_faces", "VoronoiFaces", "voronoi_cell_volumes", "cell_volume_of"]
 
 
-def _same_part(bonds, n: int, pairs) -> np.ndarray:
-    """Per row of ``pairs``: are its two elements in one connected part of ``bonds``?"""
+def _part_labels(bonds, n: int) -> np.ndarray:
+    """Per element of ``n``, the label of its connected part of ``bonds`` (an element with no
+    bond is a part of its own)."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
     b = np.asarray(bonds, dtype=np.int64).reshape(-1, 2)
     adj = sp.coo_matrix((np.ones(len(b), dtype=np.int8), (b[:, 0], b[:, 1])), shape=(n, n))
-    label = connected_components(adj, directed=False)[1]
-    return label[pairs[:, 0]] == label[pairs[:, 1]]
+    return connected_components(adj, directed=False)[1]
 
 
 def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
@@ -199,7 +199,8 @@ class VoronoiFaces:
             dist[far[got]] = h
             far = far[~got]
         if far.size:
-            same = _same_part(ref, self.n, self.pairs[far])
+            label = _part_labels(ref, self.n)
+            same = label[self.pairs[far, 0]] == label[self.pairs[far, 1]]
             dist[far] = np.where(same, self.FAR, self.UNLINKED)
         self._ref_hops = (key, dist)
         return dist
@@ -213,21 +214,16 @@ class VoronoiFaces:
         key = np.unique(out[:, 0] * self.n + out[:, 1])  # np.unique(out, axis=0), by one int64 key
         return np.column_stack([key // self.n, key % self.n])
 
-    def _lone_faces_kept(self, sel, ref, bonds) -> np.ndarray:
+    def _lone_faces_kept(self, sel, ref, label) -> np.ndarray:
         """Which of the faces ``sel`` (pairs no reference bond linked) conduct: between elements
         that both had bonds, all; an element that never had a bond (a rattler, inside the
         solid) conducts with the neighbours of one part of the intact ``bonds`` only, the part
         its faces with bonded neighbours have most area with, so that it cannot bridge a crack
-        that has cut the solid in two (in an intact solid that is every neighbour)."""
-        from scipy.sparse.csgraph import connected_components
-        import scipy.sparse as sp
+        that has cut the solid in two (in an intact solid that is every neighbour). ``label``:
+        the elements' parts of the intact bonds (:func:`_part_labels`)."""
         n = self.n
         lone = np.bincount(ref.ravel(), minlength=n) == 0
         i, j = self.pairs[sel, 0], self.pairs[sel, 1]
-        if not (lone[i] | lone[j]).any():
-            return np.ones(sel.size, bool)
-        adj = sp.coo_matrix((np.ones(len(bonds), dtype=np.int8), (bonds[:, 0], bonds[:, 1])), shape=(n, n))
-        label = connected_components(adj, directed=False)[1]
         one = lone[i] ^ lone[j]
         k = np.where(lone[i], i, j)[one]
         m = np.where(lone[i], j, i)[one]
@@ -271,12 +267,13 @@ class VoronoiFaces:
         farther = ~was_bond & ~keep & (dist > hops)
         # beyond FAR_HOPS: while the intact bonds still link them at all (not once a crack has
         # cut the part in two); a pair no bond linked in the reference: the facet test alone
+        label = _part_labels(b, n) if np.any(farther & (dist > self.FAR_HOPS)) else None
         for h in np.unique(dist[farther]):
             sel = np.flatnonzero(farther & (dist == h))
             if h == self.UNLINKED:
-                keep[sel] = self._lone_faces_kept(sel, ref, b)
+                keep[sel] = self._lone_faces_kept(sel, ref, label)
             elif h == self.FAR:
-                keep[sel] = _same_part(b, n, self.pairs[sel])
+                keep[sel] = label[self.pairs[sel, 0]] == label[self.pairs[sel, 1]]
             else:
                 keep[sel] = self.linked(b, int(h), self.pairs[sel])
         bi = self.index_of(broken)
