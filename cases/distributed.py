@@ -16,6 +16,10 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     The rod with its electrodes and conditions on the container's faces: the top face fed
     ROD_I and 0.5 W of heat, the bottom face grounded and held at 293 K, convection on the
     side, a source in the whole rod (each rank chooses the faces' elements on its region).
+``rod-cells``
+    The ``rod`` case with ``Integrator(joule_sharing='cells')``: each element's Joule heat
+    from the field over its cell (gradients from the ghosts' potentials, the total summed over
+    the ranks).
 ``bed``
     A granular bed settling on a floor under gravity (hexagonal lattice, contact law), Joule-
     heated between its two ends, one end at 293 K, Crank-Nicolson, serial engine beside the
@@ -161,11 +165,12 @@ def _pair(make, calls, steps_per_call, electrical=True, walls=(), fed=None):
 ROD_I = 200.0
 
 
-def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False):
+def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False, sharing="edges"):
     """``surface``: the electrodes and conditions on the container's faces instead of element
     layers: the top face fed ROD_I and 0.5 W of heat, the bottom face grounded and held at
     293 K, the side cooled by convection (each element joined through its half cell, the faces
-    chosen on each rank's region), and a source of 1e8 W/m^3 in the whole rod."""
+    chosen on each rank's region), and a source of 1e8 W/m^3 in the whole rod. ``sharing``: the
+    Joule heat's ``Integrator(joule_sharing=...)``."""
     from rod_resistance import RHO_304L, build_rod
     from yade_electro.geometry.shapes import as_shape
     from yade_electro.yade import (Convection, ElectroThermalEngine, Electrode, FixedTemperature, HeatFlux,
@@ -189,7 +194,8 @@ def rod_case(n=3000, calls=5, cache_dir=None, law="voronoi", surface=False):
     def make(solver, label):
         return ElectroThermalEngine(
             material=mat, law=Law(law, container=rod) if law == "voronoi" or surface else law,
-            boundaries=boundaries, temperature=T0, integrator=Integrator(theta="backward-euler", dt=1e-3),
+            boundaries=boundaries, temperature=T0,
+            integrator=Integrator(theta="backward-euler", dt=1e-3, joule_sharing=sharing),
             solver=solver, iterPeriod=1, label=label, output=Output(write_back=None))
     return _pair(make, calls, 1, fed="top" if surface else None)
 
@@ -515,9 +521,10 @@ def mem_case(n: int) -> dict:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", default="rod,rod-continuum,rod-surface-voronoi,rod-surface-continuum,pin,pin-voronoi,"
-                                       "bed,walls,heat,mpy",
-                    help="comma-separated: rod, rod-continuum, rod-surface-voronoi, rod-surface-continuum, pin, "
+    ap.add_argument("--cases", default="rod,rod-continuum,rod-surface-voronoi,rod-surface-continuum,rod-cells,pin,"
+                                       "pin-voronoi,bed,walls,heat,mpy",
+                    help="comma-separated: rod, rod-continuum, rod-surface-voronoi, rod-surface-continuum, rod-cells, "
+                         "pin, "
                          "pin-voronoi, bed, walls, heat, mpy or mpy-walls (one of them, last), mem")
     ap.add_argument("--quick", action="store_true", help="small sizes (the CI test)")
     ap.add_argument("--n-rod", type=int, default=3000)
@@ -546,6 +553,9 @@ def main(argv=None):
         if f"rod-surface-{law}" in cases:
             _say(f"rod, {law} law, electrodes and conditions on its faces: {n_rod} elements")
             out[f"rod_surface_{law}"] = rod_case(n_rod, cache_dir=args.cache_dir, law=law, surface=True)
+    if "rod-cells" in cases:
+        _say(f"rod, Joule heat shared by cells: {n_rod} elements")
+        out["rod_cells"] = rod_case(n_rod, cache_dir=args.cache_dir, sharing="cells")
     if "pin" in cases:
         n_pin = 1000 if args.quick else args.n_pin
         _say(f"pin: {n_pin} elements")

@@ -29,8 +29,8 @@ def test_distributed_case_matches_serial_with_two_workers(yade_exe):
     assert res.returncode == 0 and len(rows) == 1, res.stdout[-2000:] + res.stderr[-4000:]
     out = rows[0]
     assert out["workers"] == {"plain_mpiexec": 3, "yade_mpy": 2}
-    for case in ("rod", "rod_continuum", "rod_surface_voronoi", "rod_surface_continuum", "pin", "pin_voronoi", "bed",
-                 "walls", "heat", "mpy"):
+    for case in ("rod", "rod_continuum", "rod_surface_voronoi", "rod_surface_continuum", "rod_cells", "pin",
+                 "pin_voronoi", "bed", "walls", "heat", "mpy"):
         assert out[case]["max_rel_diff"] < 1e-8, (case, out[case])
     walls = out["walls"]                                   # the floor: an electrode and an isothermal wall
     assert walls["wall_contacts_equal"] and walls["wall_contacts_serial_distributed"][0] > 10, walls
@@ -40,7 +40,7 @@ def test_distributed_case_matches_serial_with_two_workers(yade_exe):
         rod = out[f"rod_surface_{law}"]
         assert abs(rod["I_top"] - 200.0) < 1e-6 and rod["fed_potential_rel_diff"] < 1e-8 and rod["T_rise_K"] > 1, rod
     assert out["rod"]["elements"] > 900 and out["rod"]["owned"] < out["rod"]["elements"]
-    assert out["bed"]["T_rise_K"] > 1.0 and out["rod"]["T_rise_K"] > 10.0
+    assert out["bed"]["T_rise_K"] > 1.0 and out["rod"]["T_rise_K"] > 10.0 and out["rod_cells"]["T_rise_K"] > 10.0
     assert out["mpy"]["calls"] >= 5 and out["max_rel_diff"] < 1e-8
     sub = out["heat"]["substeps_serial_distributed"]
     assert sub[0] == sub[1] > 1                            # forward Euler split the same way
@@ -115,22 +115,6 @@ try:
 except BoundaryConditionError as exc:
     print("REFUSED", exc, flush=True)
 """
-
-
-CELLS_SHARING_SCRIPT = BAD_SCRIPT.replace("import ElectricalEngine,", "import ElectroThermalEngine, Integrator, FixedTemperature,").replace(
-    """    ElectricalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], current=1.0),
-                                 Electrode("b", select=ids[z > 6.5], current=-1.0)], **kw)""",
-    """    kw["material"] = Material(resistivity=1e-6, density=7900.0, specific_heat=500.0, conductivity=16.2)
-    ElectroThermalEngine(boundaries=[Electrode("a", select=ids[z < 0.5], potential=1.0),
-                                     Electrode("b", select=ids[z > 6.5], potential=0.0),
-                                     FixedTemperature("cold", nodes=ids[z < 0.5], temperature=300.0)],
-                         temperature=300.0, integrator=Integrator(dt=1e-3, joule_sharing="cells"), **kw)""")
-
-
-def test_cells_joule_sharing_is_refused_in_a_distributed_run_when_built(yade_exe, tmp_path):
-    assert "joule_sharing=\"cells\"" in CELLS_SHARING_SCRIPT
-    out = _refused_on_both_ranks(yade_exe, tmp_path, CELLS_SHARING_SCRIPT)
-    assert out.count("Integrator(joule_sharing='cells')") == 2, out
 
 
 def test_voronoi_law_is_refused_with_yade_mpy_when_built(yade_exe, tmp_path):

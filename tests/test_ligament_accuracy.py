@@ -125,3 +125,37 @@ def test_an_element_that_never_had_a_bond_does_not_bridge_a_crack():
     assert {(3, 10), (6, 10)} <= key
     key = {tuple(p) for p in faces.cracked(pos, np.delete(chain, 4, axis=0), chain)}
     assert (6, 10) in key and (3, 10) not in key
+
+
+def test_cells_joule_sharing_split_over_ranks_is_the_serial_one():
+    """A distributed rank computes its owned elements' cell sources from its share (owned
+    elements first, then ghosts) and the ranks' sums: two ranks give the serial sources."""
+    rng = np.random.default_rng(3)
+    pos = rng.uniform(0, 1e-3, size=(300, 3))
+    from scipy.spatial import Delaunay
+    tri = Delaunay(pos).simplices
+    edges = np.unique(np.sort(np.concatenate([tri[:, [a, b]] for a in range(4) for b in range(a + 1, 4)]), axis=1),
+                      axis=0)
+    u = 3.0 * pos[:, 0] + 50.0 * pos[:, 1] ** 2 + rng.normal(0, 1e-5, 300)
+    volume, rho = rng.uniform(1, 2, 300) * 1e-12, rng.uniform(1, 3, 300) * 1e-6
+    p_edge = rng.uniform(0.5, 1.5, 300)
+    serial = cell_joule_sources(pos, edges, u, volume, rho, p_edge)
+    owner = (pos[:, 2] > 0.5e-3).astype(int)
+    shares = []
+    for rank in (0, 1):
+        own = np.flatnonzero(owner == rank)
+        held = edges[(owner[edges[:, 0]] == rank) | (owner[edges[:, 1]] == rank)]
+        ghosts = np.setdiff1d(np.unique(held), own)
+        nodes = np.concatenate([own, ghosts])
+        local = np.full(300, -1)
+        local[nodes] = np.arange(nodes.size)
+        shares.append((own, nodes, local[held]))
+    sums = []
+    for own, nodes, e in shares:          # each rank's two sums, then every rank's with the total
+        cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
+                           reduce=lambda v: sums.append(v) or v)
+    total = sum(sums)
+    for own, nodes, e in shares:
+        got = cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
+                                 reduce=lambda v: total)
+        np.testing.assert_allclose(got, serial[own], rtol=1e-12)

@@ -170,6 +170,7 @@ class DistributedElectroThermal:
     feeds : list of Feed (heat fluxes and sources, with heat)
     temperature : float, initial temperature [K]; None: no heat (conduction only)
     theta : the integrator's theta; eta : the share of the Joule power turned into heat;
+    joule_sharing : 'edges' or 'cells', as ``Integrator(joule_sharing=...)``;
     safety, max_substeps : the explicit sub-steps (see PartitionedHeat)
     volume_fraction : float or None (the continuum model's from the bonds)
     preconditioner : of the partitioned solves ('deflation', 'hypre', 'gamg', 'jacobi')
@@ -180,6 +181,7 @@ class DistributedElectroThermal:
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
                  walls: Sequence[IsothermalWall] = (), feeds: Sequence[Feed] = (),
                  temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
+                 joule_sharing: str = "edges",
                  volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
@@ -208,6 +210,7 @@ class DistributedElectroThermal:
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
         self.temperature0 = temperature
         self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
+        self.joule_sharing = joule_sharing
         self.safety, self.max_substeps = float(safety), int(max_substeps)
         self.preconditioner, self.rtol = preconditioner, float(rtol)
         # the deflation's smoother, by system (bench/bench_peers.py, partitioned lines): ICC
@@ -344,6 +347,17 @@ class DistributedElectroThermal:
             return m.density * m.specific_heat * share.volume
         fv = volume_fraction(g)[:n] if self.volume_fraction is None else self.volume_fraction
         return m.density * m.specific_heat * g.volume[:n] / fv
+
+    def _cell_sources(self, share: Share, power) -> np.ndarray:
+        """The owned elements' Joule heat [W] given by the field over their cells (as serially:
+        :func:`~yade_electro.physics.thermal.cell_joule_sources`), the total kept over the ranks."""
+        from .thermal import cell_joule_sources
+        m, c = self.material, self.conduction
+        volume = self._capacity(share) / (m.density * m.specific_heat)
+        rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(self.T, float))
+        edges = c.network.edges[np.asarray(c.conductance) > 0]
+        return cell_joule_sources(share.graph.pos, edges, c.potential, volume, rho, power, owned=share.n_owned,
+                                  reduce=lambda v: summed(self.comm, v))
 
     def _conductance(self, T_owned) -> np.ndarray:
         """Electrical conductances [S] of the share's edges at the owned temperatures [K]
@@ -523,6 +537,8 @@ class DistributedElectroThermal:
             self.conduction.update_conductance(self._conductance(self.T), links)
             self.conduction.solve(self._potentials(), self._currents())
             power = self.eta * self.conduction.joule_power()
+            if self.joule_sharing == "cells" and share.graph is not None:
+                power = self._cell_sources(share, power)
             currents = self.conduction.electrode_currents()
             row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
             volts = self.conduction.electrode_potentials()

@@ -61,7 +61,8 @@ class Integrator:
         half-and-half sharing a cell in a uniform field gets 0.68-1.25 times its volume's
         share (the split follows its faces' orientations), which shows in local
         temperatures before conduction evens it out (``cases/narrow_ligament.py``: -7 % at
-        0.5 ms with ``'edges'``, -1.4 % with ``'cells'``).
+        0.5 ms with ``'edges'``, -1.4 % with ``'cells'``). Distributed runs do it too (each
+        rank from its ghosts' potentials, the total summed over the ranks).
     coupling_iterations : int
         0 (default): the Joule sources of a step use the resistivity at its start (first order
         in dt). k > 0: the potential is re-solved up to k times with rho_e at the mid-step

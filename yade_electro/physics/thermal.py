@@ -138,7 +138,7 @@ def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float =
     return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
 
 
-def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources) -> np.ndarray:
+def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources, owned=None, reduce=None) -> np.ndarray:
     """Joule power per element [W] from the field over its cell: ``V_i |g_i|^2 / rho_i``, with
     ``g_i`` [V/m] the least-squares gradient of the node ``potential`` [V] over the element's
     neighbours along ``edges`` (weights 1 / l^2; exact for a uniform field), ``volume`` [m^3]
@@ -146,30 +146,37 @@ def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources)
     ``edge_sources`` [W] (the network's power, e.g. :func:`joule_sources`). An element whose
     neighbours do not span three dimensions (fewer than three directions) keeps its value of
     ``edge_sources``, and the rest are scaled to what remains. Elements with no power in
-    ``edge_sources`` (floating parts) get none."""
+    ``edge_sources`` (floating parts) get none.
+
+    A distributed rank: ``owned``, the number of its elements (the first rows of ``pos`` and
+    ``potential``; the rest are ghosts, whose potentials the gradients use); ``volume``,
+    ``resistivity`` and ``edge_sources`` are then the owned elements', and ``reduce`` maps the
+    rank's two sums (the kept edge power, the cells' power) to the sums over every rank."""
     pos = np.asarray(pos, float)
     e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     n = pos.shape[0]
+    r = n if owned is None else int(owned)
     u = np.asarray(potential, float)[:n]
     p_edge = np.asarray(edge_sources, float)
     d = pos[e[:, 1]] - pos[e[:, 0]]
     w = 1.0 / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
     du = u[e[:, 1]] - u[e[:, 0]]
-    M = np.zeros((n, 3, 3))
-    b = np.zeros((n, 3))
+    M = np.zeros((r, 3, 3))
+    b = np.zeros((r, 3))
+    mine = [e[:, k] < r for k in (0, 1)]
     for a in range(3):                         # both ends: d and du change sign together
-        b[:, a] = np.bincount(e[:, 0], w * du * d[:, a], n) + np.bincount(e[:, 1], w * du * d[:, a], n)
+        b[:, a] = sum(np.bincount(e[mk, k], (w * du * d[:, a])[mk], r) for k, mk in enumerate(mine))
         for c in range(a, 3):
-            m = np.bincount(e[:, 0], w * d[:, a] * d[:, c], n) + np.bincount(e[:, 1], w * d[:, a] * d[:, c], n)
-            M[:, a, c] = M[:, c, a] = m
-    eig = np.linalg.eigvalsh(M)                # (n, 3) ascending; the weights make M dimensionless
+            wdd = w * d[:, a] * d[:, c]
+            M[:, a, c] = M[:, c, a] = sum(np.bincount(e[mk, k], wdd[mk], r) for k, mk in enumerate(mine))
+    eig = np.linalg.eigvalsh(M)                # (r, 3) ascending; the weights make M dimensionless
     ok = (eig[:, 0] > 1e-6 * np.maximum(eig[:, 2], 1e-300)) & (p_edge > 0)
-    g = np.zeros((n, 3))
+    g = np.zeros((r, 3))
     g[ok] = np.linalg.solve(M[ok], b[ok][:, :, None])[:, :, 0]
-    rho = np.broadcast_to(np.asarray(resistivity, float), (n,))
+    rho = np.broadcast_to(np.asarray(resistivity, float), (r,))
     p = np.where(ok, np.asarray(volume, float) * np.einsum("ij,ij->i", g, g) / rho, 0.0)
-    rest = float(p_edge[ok].sum())
-    total = float(p.sum())
+    sums = np.array([p_edge[ok].sum(), p.sum()])
+    rest, total = (sums if reduce is None else np.asarray(reduce(sums), float)).tolist()
     out = p_edge.copy()
     out[ok] = p[ok] * (rest / total) if total > 0 else p_edge[ok]
     return out

@@ -94,7 +94,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
     select, surface, wall, potential, current); ``electrode_ids`` and ``condition_ids`` the
     body ids their selections chose when the engine was built; ``heat`` the thermal settings
     (density, specific_heat, conductivity, temperature, beta, reference_temperature, eta,
-    theta, volume_fraction), None for conduction only; ``conditions`` the heat boundary
+    theta, joule_sharing, volume_fraction), None for conduction only; ``conditions`` the heat boundary
     conditions; ``walls`` the thermal walls, name -> dict(bodies=, temperature= K or None
     (adiabatic: conducts nothing), conductivity=)."""
     if materials is not None:
@@ -161,6 +161,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                                      walls=isothermal, feeds=feeds,
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
+                                     joule_sharing=h.get("joule_sharing", "edges"),
                                      volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
                                      max_substeps=h.get("max_substeps", 100000), preconditioner=PETSC_SOLVERS[solver],
                                      comm=comm)

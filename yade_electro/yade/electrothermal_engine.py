@@ -370,11 +370,9 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
 
     def _distributed_calls(self, graph):
         t, c = self._thermal, self._coupled
-        if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id or \
-                c.integrator.joule_sharing != "edges":
+        if self.steady or self.overlap or c.coupling_iterations or self._initial_by_id:
             raise BoundaryConditionError("a distributed run (solver='petsc' under mpiexec) does not do steady states, "
-                                         "overlapped calls, coupling iterations, Integrator(joule_sharing='cells') "
-                                         "or InitialTemperature(by_id=...) yet")
+                                         "overlapped calls, coupling iterations or InitialTemperature(by_id=...) yet")
         refuse_clumps(self.reader)
         specs = self.model.specs if self.model is not None else ()
         ids = self._electrode_ids(graph)
@@ -385,6 +383,7 @@ class ElectroThermalEngine(OverlappedCalls, ElectricalEngine):
         vf = c.volume_fraction if not callable(c.volume_fraction) else getattr(c.volume_fraction, "without_clumps", None)
         heat = dict(density=t["density"], specific_heat=t["specific_heat"], conductivity=t["conductivity"],
                     temperature=t["temperature"], beta=t["beta"], eta=t["eta"], theta=t["theta"],
+                    joule_sharing=c.integrator.joule_sharing,
                     reference_temperature=t["coupled_options"].get("reference_temperature"), volume_fraction=vf,
                     safety=c.heat_options["safety"], max_substeps=c.heat_options["max_substeps"])
         model = distributed_model(solver=self._distributed_solver(), resistivity=self._resistivity,
