@@ -180,8 +180,7 @@ class DistributedElectroThermal:
     def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
                  walls: Sequence[IsothermalWall] = (), feeds: Sequence[Feed] = (),
-                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0,
-                 joule_sharing: str = "edges",
+                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0, joule_sharing="edges",
                  volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
@@ -209,8 +208,7 @@ class DistributedElectroThermal:
         self._surfaces: Dict[str, tuple] = {}    # name -> (ids, g [m] or area [m^2]) on a surface
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
         self.temperature0 = temperature
-        self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
-        self.joule_sharing = joule_sharing
+        self.theta, self.eta, self.volume_fraction, self.joule_sharing = theta, float(eta), volume_fraction, joule_sharing
         self.safety, self.max_substeps = float(safety), int(max_substeps)
         self.preconditioner, self.rtol = preconditioner, float(rtol)
         # the deflation's smoother, by system (bench/bench_peers.py, partitioned lines): ICC
@@ -349,9 +347,12 @@ class DistributedElectroThermal:
         return m.density * m.specific_heat * g.volume[:n] / fv
 
     def _cell_sources(self, share: Share, power) -> np.ndarray:
-        """The owned elements' Joule heat [W] given by the field over their cells (as serially:
-        :func:`~yade_electro.physics.thermal.cell_joule_sources`), the total kept over the ranks."""
+        """The owned elements' Joule heat [W] by :func:`.thermal.cell_joule_sources`, the total
+        kept over the ranks (collective: a rank that owns nothing joins the sums)."""
         from .thermal import cell_joule_sources
+        if share.graph is None:
+            summed(self.comm, np.zeros(2))
+            return power
         m, c = self.material, self.conduction
         volume = self._capacity(share) / (m.density * m.specific_heat)
         rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(self.T, float))
@@ -537,7 +538,7 @@ class DistributedElectroThermal:
             self.conduction.update_conductance(self._conductance(self.T), links)
             self.conduction.solve(self._potentials(), self._currents())
             power = self.eta * self.conduction.joule_power()
-            if self.joule_sharing == "cells" and share.graph is not None:
+            if self.joule_sharing == "cells":
                 power = self._cell_sources(share, power)
             currents = self.conduction.electrode_currents()
             row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
