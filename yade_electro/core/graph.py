@@ -16,7 +16,15 @@ from scipy.sparse.csgraph import connected_components
 
 from .errors import GraphError
 
-__all__ = ["ContactGraph"]
+__all__ = ["ContactGraph", "connected_parts"]
+
+
+def connected_parts(n_nodes: int, edges) -> tuple:
+    """(count, label per node) of the connected parts of ``n_nodes`` nodes joined by ``edges``
+    ((m, 2) node indices); a node with no edge is a part of its own."""
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    adj = sp.coo_matrix((np.ones(e.shape[0]), (e[:, 0], e[:, 1])), shape=(n_nodes, n_nodes))
+    return connected_components(adj, directed=False)
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -157,11 +165,7 @@ class ContactGraph:
     @property
     def components(self) -> tuple:
         """(count, label per node) of the connected components of the bond graph."""
-        def make():
-            n = self.n_nodes
-            adj = sp.coo_matrix((np.ones(self.n_edges), (self.edges[:, 0], self.edges[:, 1])), shape=(n, n))
-            return connected_components(adj, directed=False)
-        return self._cached("components", make)
+        return self._cached("components", lambda: connected_parts(self.n_nodes, self.edges))
 
     def index_of(self, ids) -> np.ndarray:
         """Node indices of the given caller ids (e.g. YADE body ids); unknown ids raise."""

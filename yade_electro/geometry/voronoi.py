@@ -47,21 +47,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.graph import connected_parts
 from .cells import bounded_cells
 from .cell_clipping import clipped_by_planes
 from .ghosts import ghost_points, tessellate_with_ghosts
 
 __all__ = ["voronoi_faces", "VoronoiFaces", "voronoi_cell_volumes", "cell_volume_of"]
-
-
-def _part_labels(bonds, n: int) -> np.ndarray:
-    """Per element of ``n``, the label of its connected part of ``bonds`` (an element with no
-    bond is a part of its own)."""
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-    b = np.asarray(bonds, dtype=np.int64).reshape(-1, 2)
-    adj = sp.coo_matrix((np.ones(len(b), dtype=np.int8), (b[:, 0], b[:, 1])), shape=(n, n))
-    return connected_components(adj, directed=False)[1]
 
 
 def voronoi_faces(pos, radius, container=None, neighbour_barycentre=None, threshold=0.4):
@@ -199,7 +190,7 @@ class VoronoiFaces:
             dist[far[got]] = h
             far = far[~got]
         if far.size:
-            label = _part_labels(ref, self.n)
+            label = connected_parts(self.n, ref)[1]
             same = label[self.pairs[far, 0]] == label[self.pairs[far, 1]]
             dist[far] = np.where(same, self.FAR, self.UNLINKED)
         self._ref_hops = (key, dist)
@@ -217,10 +208,10 @@ class VoronoiFaces:
     def _lone_faces_kept(self, sel, ref, label) -> np.ndarray:
         """Which of the faces ``sel`` (pairs no reference bond linked) conduct: between elements
         that both had bonds, all; an element that never had a bond (a rattler, inside the
-        solid) conducts with the neighbours of one part of the intact ``bonds`` only, the part
+        solid) conducts with the neighbours of one part of the intact bonds only, the part
         its faces with bonded neighbours have most area with, so that it cannot bridge a crack
         that has cut the solid in two (in an intact solid that is every neighbour). ``label``:
-        the elements' parts of the intact bonds (:func:`_part_labels`)."""
+        the elements' parts of the intact bonds (:func:`~yade_electro.core.graph.connected_parts`)."""
         n = self.n
         lone = np.bincount(ref.ravel(), minlength=n) == 0
         i, j = self.pairs[sel, 0], self.pairs[sel, 1]
@@ -267,7 +258,7 @@ class VoronoiFaces:
         farther = ~was_bond & ~keep & (dist > hops)
         # beyond FAR_HOPS: while the intact bonds still link them at all (not once a crack has
         # cut the part in two); a pair no bond linked in the reference: the facet test alone
-        label = _part_labels(b, n) if np.any(farther & (dist > self.FAR_HOPS)) else None
+        label = connected_parts(n, b)[1] if np.any(farther & (dist > self.FAR_HOPS)) else None
         for h in np.unique(dist[farther]):
             sel = np.flatnonzero(farther & (dist == h))
             if h == self.UNLINKED:

@@ -28,10 +28,9 @@ import warnings
 from typing import Mapping, Optional, Sequence
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ..core.errors import BoundaryConditionError, ThermalError
+from ..core.graph import connected_parts
 from ..solvers.measured import MeasuredChoice
 from ..solvers.partitioned import GhostExchange, PartitionedSystem, mpi_comm, number_unknowns, summed
 from .floating import floating_message
@@ -45,9 +44,7 @@ def spread_over_parts(network: LocalNetwork, exchange: GhostExchange, owned_valu
     """Each owned node's value made the ``op`` ('min' or 'max') over its whole connected part,
     across the ranks (collective). Rounds: one per rank boundary a part crosses, plus one."""
     n, nl = network.n_owned, network.n_local
-    e = network.edges
-    adj = sp.coo_matrix((np.ones(e.shape[0]), (e[:, 0], e[:, 1])), shape=(nl, nl))
-    _, comp = connected_components(adj, directed=False)
+    _, comp = connected_parts(nl, network.edges)
     reduce = np.minimum if op == "min" else np.maximum
     v = np.asarray(owned_values).copy()
     while True:

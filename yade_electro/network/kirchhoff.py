@@ -9,8 +9,8 @@ from typing import ClassVar, Dict, Optional
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from ..core.graph import connected_parts
 from .boundary import TerminalRole, check_condition, terminal_number
 
 __all__ = ["laplacian", "network_components", "electrode_value", "edge_power", "PotentialOrCurrent",
@@ -44,8 +44,7 @@ def network_components(n_nodes: int, edges, conducting=None) -> tuple:
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     if conducting is not None:
         edges = edges[np.asarray(conducting, bool)]
-    adj = sp.coo_matrix((np.ones(edges.shape[0]), (edges[:, 0], edges[:, 1])), shape=(n_nodes, n_nodes))
-    return connected_components(adj, directed=False)
+    return connected_parts(n_nodes, edges)
 
 
 def electrode_value(name: str, value) -> float:
