@@ -13,6 +13,9 @@ Joule-rod case's thermal step), 304L, 1 V between the end layers, law 'continuum
 * ``rho_T_step_ratio`` (and ``_voronoi``): one backward-Euler step with beta = 1e-3 over one
   with beta = 0, same packing, the two models stepped in turn after ``WARMUP`` (10) steps
   (target <= 1.5);
+* ``cells_over_edges_step_ratio_voronoi``: under 'voronoi', the rho_e(T) step with the default
+  Joule sharing ('cells': a least-squares field per cell at each re-solve) over the same step
+  with ``Integrator(joule_sharing='edges')``, stepped in turn with the others;
 * ``*_first``: the first step (assembly, potential solve, capacities, factorisation);
 * ``engine_call``: the whole PyRunner call of an ``ElectroThermalEngine`` (scene read with
   the unchanged-graph check, coupled step, temperatures written to ``b.state.temp`` and
@@ -65,11 +68,11 @@ def bench_size(n, repeat=5, seed=1):
                   "bottom": dict(select=graph.index_of(ids[bottom]), potential=0.0)}
     container = Cylinder((0, 0, 0), (0, 0, rod.LENGTH), rod.RADIUS)
 
-    def model(theta, beta, law="continuum"):
+    def model(theta, beta, law="continuum", sharing="auto"):
         el = ElectricalModel(rod.RHO_304L, electrodes, law=Law(law, container=container if law == "voronoi" else None))
         material = Material(density=jr.DENSITY, specific_heat=jr.SPECIFIC_HEAT, conductivity=jr.CONDUCTIVITY,
                             beta=beta, reference_temperature=jr.T0)
-        return ElectroThermalModel(el, material, jr.T0, integrator=Integrator(theta=theta))
+        return ElectroThermalModel(el, material, jr.T0, integrator=Integrator(theta=theta, joule_sharing=sharing))
 
     for law in ("continuum", "voronoi"):
         suffix = "" if law == "continuum" else "_voronoi"   # put before "_ms": to_ms converts "*_ms"
@@ -77,9 +80,12 @@ def bench_size(n, repeat=5, seed=1):
             if law == "voronoi" and tag == "explicit":
                 continue
             models = {}
-            for var, beta in (("unchanged", 0.0), ("rho_T", BETA)):
+            variants = [("unchanged", 0.0, "auto"), ("rho_T", BETA, "auto")]
+            if law == "voronoi":            # the default 'cells' Joule sharing against the links' 'edges'
+                variants.append(("rho_T_edges", BETA, "edges"))
+            for var, beta, sharing in variants:
                 t = time.perf_counter()
-                m = model(theta, beta, law)
+                m = model(theta, beta, law, sharing)
                 m.step(graph, DT)
                 out[f"{tag}_{var}_first{suffix}_ms"] = time.perf_counter() - t
                 for _ in range(WARMUP):
@@ -99,6 +105,8 @@ def bench_size(n, repeat=5, seed=1):
                 out[f"{tag}_{var}_potential_solves_per_step{suffix}"] = (m.n_potential_solves - solves0[var]) / repeat
             if tag == "be":
                 out[f"rho_T_step_ratio{suffix}"] = round(min(times["rho_T"]) / min(times["unchanged"]), 3)
+            if "rho_T_edges" in times:
+                out[f"cells_over_edges_step_ratio{suffix}"] = round(min(times["rho_T"]) / min(times["rho_T_edges"]), 3)
     out["dt_critical_ms"] = models["unchanged"].time_steps()["critical"] * 1e3
 
     # the engine's whole PyRunner call

@@ -91,12 +91,32 @@ def test_cells_joule_sharing_is_exact_in_a_uniform_field(ligament):
     np.testing.assert_allclose(out[inner] / exact[inner], out.sum() / exact.sum(), rtol=1e-9)
     spread = edges[inner] / exact[inner]
     assert spread.max() - spread.min() > 0.1                 # what 'edges' does per element
+    # an electrode's own elements (held) keep their edge share, the others share the rest alike
+    held = pos[:, 0] < pos[:, 0].min() + 2.0 * graph.radius
+    kept = cell_joule_sources(pos, e, u, cells.volume, rho, edges, held=held)
+    np.testing.assert_array_equal(kept[held], edges[held])
+    assert kept.sum() == pytest.approx(edges.sum(), rel=1e-12)
+    free = inner & ~held
+    np.testing.assert_allclose(kept[free] / exact[free], (kept.sum() - edges[held].sum()) / exact[~held].sum(),
+                               rtol=1e-9)
     # an element with one neighbour keeps its edge share; the others share the rest
     lone = np.array([[0, 1]])
     got = cell_joule_sources(pos[:2], lone, u[:2], np.ones(2), rho, np.array([1.0, 1.0]))
     np.testing.assert_array_equal(got, [1.0, 1.0])
-    with pytest.raises(ValueError, match="joule_sharing must be 'edges'"):
+    with pytest.raises(ValueError, match="joule_sharing must be 'auto'"):
         Integrator(joule_sharing="faces")
+
+
+def test_the_default_joule_sharing_is_cells_for_a_bonded_voronoi_solid_only():
+    """'auto' (the default) reads a Voronoi solid as a continuum (cells) and keeps a contact's
+    heat at the contact under every other law; an explicit choice is kept under any law."""
+    default = Integrator()
+    assert default.joule_sharing == "auto"
+    assert default.joule_sharing_for("voronoi") == "cells"
+    for law in ("continuum", "contact", "liggghts", "pipe", "grains"):
+        assert default.joule_sharing_for(law) == "edges"
+    assert Integrator(joule_sharing="edges").joule_sharing_for("voronoi") == "edges"
+    assert Integrator(joule_sharing="cells").joule_sharing_for("contact") == "cells"
 
 
 def test_far_pairs_stop_conducting_once_a_crack_cuts_the_part_in_two():

@@ -434,11 +434,11 @@ class ElectroThermalModel:
         el = self.electrical
         sol = el.solve()
         if sol is not self._sol_id:
-            self.solution = sol
-            self._sol_id = sol
+            self.solution = self._sol_id = sol
             self.n_potential_solves += 1
-            vol = self._volumes(self._prepared) if self.integrator.joule_sharing == "cells" else None
-            self.sources = el.element_joule_power(self.eta, self.integrator.joule_sharing, vol)
+            sharing = self.integrator.joule_sharing_for(self.network.law.name)
+            vol = self._volumes(self._prepared) if sharing == "cells" else None
+            self.sources = el.element_joule_power(self.eta, sharing, vol)
         return self.sources
 
     # -- stepping ----------------------------------------------------------------------------

@@ -15,10 +15,10 @@ call collective:
 * the potential with fixed-potential electrodes, branch currents, R_eq, Joule heat per element;
 * the heat step by the theta method with fixed temperatures and convection.
 
-The 'voronoi' law's faces need a tessellation, wider than the pairs: its shares are carved
-by :func:`~yade_electro.physics.shares.carve_region_share` from the rank's *region* (its own elements and a halo around
-them), on which the rank's law object tessellates, once per region; the factors and the cell
-volumes (the heat capacities) of the owned elements come from there.
+The 'voronoi' law's faces need a tessellation, wider than the pairs: its shares are carved by
+:func:`~yade_electro.physics.shares.carve_region_share` from the rank's *region* (its own elements and a halo
+around them), on which the rank's law object tessellates, once per region; the factors and the
+cell volumes (heat capacities, 'cells' Joule sharing) of the owned elements come from there.
 
 Walls of a granular bed (YADE bodies every rank sees: under yade.mpy the master's) join the
 spheres touching them to a value held apart from the elements: a wall electrode's potential,
@@ -29,8 +29,7 @@ hand side on its sphere's row, so the walls add no row, no column and no message
 Electrodes fed an imposed current are met by superposition (one solve more per such
 electrode, each on the kept setup: :class:`~yade_electro.network.distributed.PartitionedConduction`).
 
-What it does not do (yet) raises :class:`~yade_electro.core.errors.BoundaryConditionError`
-when the engine is built: per-material tables.
+Per-material tables (not done yet) raise :class:`~yade_electro.core.errors.BoundaryConditionError` at setup.
 
 Units: SI (m, ohm m, S, V, A, W, K, J/K, W/K, s).
 """
@@ -49,6 +48,7 @@ from ..laws.factors import edge_lengths, is_contact_law, make_law
 from ..laws.transmission import exposed_area, transmission_surface, volume_fraction
 from ..network.distributed import PartitionedConduction, PartitionedHeat
 from ..solvers.partitioned import GhostExchange, mpi_comm, summed
+from .integrator import joule_sharing_for
 from .shares import Share
 
 __all__ = ["DistributedElectroThermal", "Held", "Exchange", "IsothermalWall", "Feed", "DISTRIBUTED_LAWS",
@@ -170,7 +170,7 @@ class DistributedElectroThermal:
     feeds : list of Feed (heat fluxes and sources, with heat)
     temperature : float, initial temperature [K]; None: no heat (conduction only)
     theta : the integrator's theta; eta : the share of the Joule power turned into heat;
-    joule_sharing : 'edges' or 'cells', as ``Integrator(joule_sharing=...)``;
+    joule_sharing : 'auto', 'edges' or 'cells', as ``Integrator(joule_sharing=...)``;
     safety, max_substeps : the explicit sub-steps (see PartitionedHeat)
     volume_fraction : float or None (the continuum model's from the bonds)
     preconditioner : of the partitioned solves ('deflation', 'hypre', 'gamg', 'jacobi')
@@ -180,7 +180,7 @@ class DistributedElectroThermal:
     def __init__(self, material: Material, law: str = "continuum", law_params: Optional[dict] = None, *,
                  electrodes: Sequence[Held] = (), fixed: Sequence[Held] = (), convection: Sequence[Exchange] = (),
                  walls: Sequence[IsothermalWall] = (), feeds: Sequence[Feed] = (),
-                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0, joule_sharing="edges",
+                 temperature: Optional[float] = None, theta="backward-euler", eta: float = 1.0, joule_sharing="auto",
                  volume_fraction: Optional[float] = None, safety: float = 0.9, max_substeps: int = 100000,
                  preconditioner: str = "deflation", rtol: float = 1e-10, comm=None):
         if law not in DISTRIBUTED_LAWS:
@@ -208,7 +208,8 @@ class DistributedElectroThermal:
         self._surfaces: Dict[str, tuple] = {}    # name -> (ids, g [m] or area [m^2]) on a surface
         self.electrodes, self.fixed, self.convection = list(electrodes), list(fixed), list(convection)
         self.temperature0 = temperature
-        self.theta, self.eta, self.volume_fraction, self.joule_sharing = theta, float(eta), volume_fraction, joule_sharing
+        self.theta, self.eta, self.volume_fraction = theta, float(eta), volume_fraction
+        self.joule_sharing = joule_sharing_for(joule_sharing, law)
         self.safety, self.max_substeps = float(safety), int(max_substeps)
         self.preconditioner, self.rtol = preconditioner, float(rtol)
         # the deflation's smoother, by system (bench/bench_peers.py, partitioned lines): ICC
@@ -358,7 +359,7 @@ class DistributedElectroThermal:
         rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(self.T, float))
         edges = c.network.edges[np.asarray(c.conductance) > 0]
         return cell_joule_sources(share.graph.pos, edges, c.potential, volume, rho, power, owned=share.n_owned,
-                                  reduce=lambda v: summed(self.comm, v))
+                                  reduce=lambda v: summed(self.comm, v), held=c.electrode_of >= 0)
 
     def _conductance(self, T_owned) -> np.ndarray:
         """Electrical conductances [S] of the share's edges at the owned temperatures [K]

@@ -276,7 +276,8 @@ class ElectricalModel:
         """Joule heat [W] per element: each network edge's eta w^2 / c shared half and half by
         its ends, a surface half cell's given to its element (``sharing='edges'``); or, with
         ``sharing='cells'`` and the elements' ``volume`` [m^3], that total given by the field
-        over each cell (:func:`~yade_electro.physics.thermal.cell_joule_sources`)."""
+        over each cell (:func:`~yade_electro.physics.thermal.cell_joule_sources`; an
+        electrode's own elements keep their edge share)."""
         from ..network.kirchhoff import edge_power
         n, m = self.n_elements, self.network.edges.shape[0]
         p = eta * edge_power(self.solution.branch_current, self.conductance)
@@ -286,8 +287,12 @@ class ElectricalModel:
             out += np.bincount(self._surface_edges[:, 0], p[m:], n)
         if sharing == "cells":
             from .thermal import cell_joule_sources
+            held = np.zeros(n, bool)
+            for el in self.problem.electrodes:          # an electrode's own elements (not surface/wall nodes)
+                nodes = np.asarray(el.nodes, dtype=np.int64)
+                held[nodes[nodes < n]] = True
             out = cell_joule_sources(self.bond_graph.pos, e[self.conductance[:m] > 0], self.solution.potential,
-                                     volume, self._resistivity_of(n), out)
+                                     volume, self._resistivity_of(n), out, held=held)
         return out
 
     def _resistivity_of(self, n):

@@ -10,7 +10,10 @@ from typing import Any, Optional
 from ..core.materials import real_number
 from ..network.theta import theta_of
 
-__all__ = ["Integrator", "MODEL_OPTIONS"]
+__all__ = ["Integrator", "MODEL_OPTIONS", "JOULE_SHARINGS", "joule_sharing_for"]
+
+#: the ways of giving the network's Joule power to the elements (``Integrator(joule_sharing=)``)
+JOULE_SHARINGS = ("auto", "edges", "cells")
 
 #: the Integrator fields the coupled model takes besides theta, eta and the solver (the engines
 #: keep the ones that differ from the default in their saved configuration)
@@ -52,14 +55,15 @@ class Integrator:
     eta : float in [0, 1]
         Share of the electrical power released as heat (paper 000 eq. 11; default 1).
     joule_sharing : str
-        How the network's Joule power is given to the elements. ``'edges'`` (default): each
-        link's ``w^2 / c`` half and half to its two ends (the heat of a granular contact
-        is made at the contact). ``'cells'``: each element gets ``V_i |g_i|^2 / rho_i``, its
-        cell's volume times the field reconstructed at it (the least-squares gradient of
-        the potential over its network neighbours, exact in a uniform field), scaled so the
-        total is the network's power: for a bonded solid read as a continuum. With
-        half-and-half sharing a cell in a uniform field gets 0.68-1.25 times its volume's
-        share (the split follows its faces' orientations), which shows in local
+        How the network's Joule power is given to the elements. ``'auto'`` (default):
+        ``'cells'`` under the ``'voronoi'`` law (a bonded solid read as a continuum),
+        ``'edges'`` under every other law. ``'edges'``: each link's ``w^2 / c`` half and half
+        to its two ends (the heat of a granular contact is made at the contact). ``'cells'``:
+        each element gets ``V_i |g_i|^2 / rho_i``, its cell's volume times the field
+        reconstructed at it (the least-squares gradient of the potential over its network
+        neighbours, exact in a uniform field), scaled so the total is the network's power.
+        With half-and-half sharing a cell in a uniform field gets 0.68-1.25 times its
+        volume's share (the split follows its faces' orientations), which shows in local
         temperatures before conduction evens it out (``cases/narrow_ligament.py``: -7 % at
         0.5 ms with ``'edges'``, -1.4 % with ``'cells'``). Distributed runs do it too (each
         rank from its ghosts' potentials, the total summed over the ranks).
@@ -92,7 +96,7 @@ class Integrator:
     coupling_iterations: int = 0
     coupling_tol: float = 1e-10
     resistivity_tol: float = 0.0
-    joule_sharing: str = "edges"
+    joule_sharing: str = "auto"
 
     def __post_init__(self):
         theta_of(self.theta)
@@ -110,9 +114,10 @@ class Integrator:
             raise ValueError(f"Integrator safety must be in (0, 1], got {self.safety}")
         if not 0.0 <= real_number("Integrator eta", self.eta) <= 1.0:
             raise ValueError(f"Integrator eta must be in [0, 1], got {self.eta}")
-        if self.joule_sharing not in ("edges", "cells"):
-            raise ValueError(f"Integrator joule_sharing must be 'edges' (each link's Joule heat half and half to "
-                             f"its ends) or 'cells' (from the field over each element's cell), got "
+        if self.joule_sharing not in JOULE_SHARINGS:
+            raise ValueError(f"Integrator joule_sharing must be 'auto' (cells under the voronoi law, edges "
+                             f"otherwise), 'edges' (each link's Joule heat half and half to its ends) or 'cells' "
+                             f"(from the field over each element's cell), got "
                              f"{self.joule_sharing!r}")
         for name in ("max_substeps", "coupling_iterations"):
             v = getattr(self, name)
@@ -124,3 +129,18 @@ class Integrator:
     def theta_value(self) -> float:
         """theta as a number in [0, 1]."""
         return theta_of(self.theta)
+
+    def joule_sharing_for(self, law_name: str) -> str:
+        """``'edges'`` or ``'cells'``: the sharing used under the conduction law named
+        ``law_name`` (``'auto'`` is ``'cells'`` under ``'voronoi'``, ``'edges'`` otherwise)."""
+        return joule_sharing_for(self.joule_sharing, law_name)
+
+
+def joule_sharing_for(sharing: str, law_name: str) -> str:
+    """``'edges'`` or ``'cells'``: what ``sharing`` (one of :data:`JOULE_SHARINGS`) means
+    under the conduction law named ``law_name``; ValueError for an unknown sharing."""
+    if sharing not in JOULE_SHARINGS:
+        raise ValueError(f"joule_sharing must be one of {', '.join(JOULE_SHARINGS)}, got {sharing!r}")
+    if sharing != "auto":
+        return sharing
+    return "cells" if law_name == "voronoi" else "edges"

@@ -138,14 +138,18 @@ def joule_sources(edges, branch_current, conductance, n_nodes: int, eta: float =
     return 0.5 * (np.bincount(edges[:, 0], p, n_nodes) + np.bincount(edges[:, 1], p, n_nodes))
 
 
-def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources, owned=None, reduce=None) -> np.ndarray:
+def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources, owned=None, reduce=None,
+                       held=None) -> np.ndarray:
     """Joule power per element [W] from the field over its cell: ``V_i |g_i|^2 / rho_i``, with
     ``g_i`` [V/m] the least-squares gradient of the node ``potential`` [V] over the element's
     neighbours along ``edges`` (weights 1 / l^2; exact for a uniform field), ``volume`` [m^3]
     and ``resistivity`` [ohm m] per element, then scaled so the total is that of
     ``edge_sources`` [W] (the network's power, e.g. :func:`joule_sources`). An element whose
     neighbours do not span three dimensions (fewer than three directions) keeps its value of
-    ``edge_sources``, and the rest are scaled to what remains. Elements with no power in
+    ``edge_sources``, and so does an element ``held`` (a boolean mask): an electrode's own
+    element, whose potential is imposed, so that the field fills only the part of its cell
+    that faces the solid, not the whole cell (the half of each link's heat that 'edges' gives
+    it is that part's); the rest are scaled to what remains. Elements with no power in
     ``edge_sources`` (floating parts) get none.
 
     A distributed rank: ``owned``, the number of its elements (the first rows of ``pos`` and
@@ -159,22 +163,36 @@ def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources,
     u = np.asarray(potential, float)[:n]
     p_edge = np.asarray(edge_sources, float)
     d = pos[e[:, 1]] - pos[e[:, 0]]
-    w = 1.0 / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+    wd = d / np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)[:, None]       # weights 1 / l^2
     du = u[e[:, 1]] - u[e[:, 0]]
-    M = np.zeros((r, 3, 3))
-    b = np.zeros((r, 3))
-    mine = [e[:, k] < r for k in (0, 1)]
-    for a in range(3):                         # both ends: d and du change sign together
-        b[:, a] = sum(np.bincount(e[mk, k], (w * du * d[:, a])[mk], r) for k, mk in enumerate(mine))
-        for c in range(a, 3):
-            wdd = w * d[:, a] * d[:, c]
-            M[:, a, c] = M[:, c, a] = sum(np.bincount(e[mk, k], wdd[mk], r) for k, mk in enumerate(mine))
-    eig = np.linalg.eigvalsh(M)                # (r, 3) ascending; the weights make M dimensionless
-    ok = (eig[:, 0] > 1e-6 * np.maximum(eig[:, 2], 1e-300)) & (p_edge > 0)
-    g = np.zeros((r, 3))
-    g[ok] = np.linalg.solve(M[ok], b[ok][:, :, None])[:, :, 0]
+
+    def at_ends(values):
+        """Per element, the sum of ``values`` over its edges (both ends: d and du change sign
+        together); the ghosts' rows (distributed) dropped."""
+        return (np.bincount(e[:, 0], values, n) + np.bincount(e[:, 1], values, n))[:r]
+
+    m00, m01, m02, m11, m12, m22 = (at_ends(wd[:, a] * d[:, c]) for a, c in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2),
+                                                                            (2, 2)))
+    # M = sum w d d^T (symmetric) solved by its cofactors: g = adj(M) b / det(M)
+    c00, c01, c02 = m11 * m22 - m12 * m12, m02 * m12 - m01 * m22, m01 * m12 - m02 * m11
+    c11, c12, c22 = m00 * m22 - m02 * m02, m01 * m02 - m00 * m12, m00 * m11 - m01 * m01
+    det = m00 * c00 + m01 * c01 + m02 * c02
+    # three directions: the smallest eigenvalue above 1e-6 of the largest (the weights make M
+    # dimensionless); det > 1e-6 trace^3 implies it, eigenvalues only for the others
+    ok = det > 1e-6 * (m00 + m11 + m22) ** 3
+    unsure = np.flatnonzero(~ok)
+    if unsure.size:
+        M = np.stack([m00, m01, m02, m01, m11, m12, m02, m12, m22], axis=1)[unsure].reshape(-1, 3, 3)
+        eig = np.linalg.eigvalsh(M)            # ascending
+        ok[unsure] = eig[:, 0] > 1e-6 * np.maximum(eig[:, 2], 1e-300)
+    ok &= p_edge > 0
+    if held is not None:
+        ok &= ~np.asarray(held, bool)[:r]
+    b0, b1, b2 = (at_ends(wd[:, a] * du) for a in range(3))
+    g = np.column_stack([c00 * b0 + c01 * b1 + c02 * b2, c01 * b0 + c11 * b1 + c12 * b2,
+                         c02 * b0 + c12 * b1 + c22 * b2]) / np.where(ok, det, 1.0)[:, None]
     rho = np.broadcast_to(np.asarray(resistivity, float), (r,))
-    p = np.where(ok, np.asarray(volume, float) * np.einsum("ij,ij->i", g, g) / rho, 0.0)
+    p = np.where(ok, np.asarray(volume, float) * np.einsum("ij,ij->i", g, g) / rho, 0.0)   # g of the others unused
     sums = np.array([p_edge[ok].sum(), p.sum()])
     rest, total = (sums if reduce is None else np.asarray(reduce(sums), float)).tolist()
     out = p_edge.copy()

@@ -161,7 +161,7 @@ def distributed_model(*, solver: str, resistivity, materials, law: str, law_para
                                      walls=isothermal, feeds=feeds,
                                      temperature=h.get("temperature") if heat else None,
                                      theta=h.get("theta", "backward-euler"), eta=h.get("eta", 1.0),
-                                     joule_sharing=h.get("joule_sharing", "edges"),
+                                     joule_sharing=h.get("joule_sharing", "auto"),
                                      volume_fraction=h.get("volume_fraction"), safety=h.get("safety", 0.9),
                                      max_substeps=h.get("max_substeps", 100000), preconditioner=PETSC_SOLVERS[solver],
                                      comm=comm)
