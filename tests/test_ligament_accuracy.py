@@ -91,13 +91,17 @@ def test_cells_joule_sharing_is_exact_in_a_uniform_field(ligament):
     np.testing.assert_allclose(out[inner] / exact[inner], out.sum() / exact.sum(), rtol=1e-9)
     spread = edges[inner] / exact[inner]
     assert spread.max() - spread.min() > 0.1                 # what 'edges' does per element
-    # an electrode's own elements (held) keep their edge share, the others share the rest alike
+    # an electrode's own elements (held) and their neighbours keep their edge share, the others
+    # share the rest alike
     held = pos[:, 0] < pos[:, 0].min() + 2.0 * graph.radius
+    near = held.copy()
+    near[e[held[e[:, 0]], 1]] = near[e[held[e[:, 1]], 0]] = True
+    assert near.sum() > held.sum() > 0
     kept = cell_joule_sources(pos, e, u, cells.volume, rho, edges, held=held)
-    np.testing.assert_array_equal(kept[held], edges[held])
+    np.testing.assert_array_equal(kept[near], edges[near])
     assert kept.sum() == pytest.approx(edges.sum(), rel=1e-12)
-    free = inner & ~held
-    np.testing.assert_allclose(kept[free] / exact[free], (kept.sum() - edges[held].sum()) / exact[~held].sum(),
+    free = inner & ~near
+    np.testing.assert_allclose(kept[free] / exact[free], (kept.sum() - edges[near].sum()) / exact[~near].sum(),
                                rtol=1e-9)
     # an element with one neighbour keeps its edge share; the others share the rest
     lone = np.array([[0, 1]])
@@ -159,23 +163,27 @@ def test_cells_joule_sharing_split_over_ranks_is_the_serial_one():
     u = 3.0 * pos[:, 0] + 50.0 * pos[:, 1] ** 2 + rng.normal(0, 1e-5, 300)
     volume, rho = rng.uniform(1, 2, 300) * 1e-12, rng.uniform(1, 3, 300) * 1e-6
     p_edge = rng.uniform(0.5, 1.5, 300)
-    serial = cell_joule_sources(pos, edges, u, volume, rho, p_edge)
-    owner = (pos[:, 2] > 0.5e-3).astype(int)
-    shares = []
-    for rank in (0, 1):
-        own = np.flatnonzero(owner == rank)
-        held = edges[(owner[edges[:, 0]] == rank) | (owner[edges[:, 1]] == rank)]
-        ghosts = np.setdiff1d(np.unique(held), own)
-        nodes = np.concatenate([own, ghosts])
-        local = np.full(300, -1)
-        local[nodes] = np.arange(nodes.size)
-        shares.append((own, nodes, local[held]))
-    sums = []
-    for own, nodes, e in shares:          # each rank's two sums, then every rank's with the total
-        cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
-                           reduce=lambda v: sums.append(v) or v)
-    total = sum(sums)
-    for own, nodes, e in shares:
-        got = cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
-                                 reduce=lambda v: total)
-        np.testing.assert_allclose(got, serial[own], rtol=1e-12)
+    # held elements (an electrode's) on both sides of the ranks' border: an owned element next to
+    # a ghost that is held keeps its edge share as in the serial run
+    pinned = np.abs(pos[:, 2] - 0.5e-3) < 0.08e-3
+    for hold in (None, pinned):
+        serial = cell_joule_sources(pos, edges, u, volume, rho, p_edge, held=hold)
+        owner = (pos[:, 2] > 0.5e-3).astype(int)
+        shares = []
+        for rank in (0, 1):
+            own = np.flatnonzero(owner == rank)
+            held = edges[(owner[edges[:, 0]] == rank) | (owner[edges[:, 1]] == rank)]
+            ghosts = np.setdiff1d(np.unique(held), own)
+            nodes = np.concatenate([own, ghosts])
+            local = np.full(300, -1)
+            local[nodes] = np.arange(nodes.size)
+            shares.append((own, nodes, local[held]))
+        sums = []
+        for own, nodes, e in shares:          # each rank's two sums, then every rank's with the total
+            cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
+                               reduce=lambda v: sums.append(v) or v, held=None if hold is None else hold[nodes])
+        total = sum(sums)
+        for own, nodes, e in shares:
+            got = cell_joule_sources(pos[nodes], e, u[nodes], volume[own], rho[own], p_edge[own], owned=own.size,
+                                     reduce=lambda v: total, held=None if hold is None else hold[nodes])
+            np.testing.assert_allclose(got, serial[own], rtol=1e-12)

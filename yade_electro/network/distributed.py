@@ -204,6 +204,12 @@ class PartitionedConduction:
         return v
 
     @property
+    def held(self) -> np.ndarray:
+        """(n_local,) bool: the local nodes (owned, then ghosts) that are an electrode's own
+        elements, held at its potential."""
+        return self._el_local < len(self.names)
+
+    @property
     def network(self) -> LocalNetwork:
         return self._share.network
 

@@ -359,7 +359,7 @@ class DistributedElectroThermal:
         rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(self.T, float))
         edges = c.network.edges[np.asarray(c.conductance) > 0]
         return cell_joule_sources(share.graph.pos, edges, c.potential, volume, rho, power, owned=share.n_owned,
-                                  reduce=lambda v: summed(self.comm, v), held=c.electrode_of >= 0)
+                                  reduce=lambda v: summed(self.comm, v), held=c.held)
 
     def _conductance(self, T_owned) -> np.ndarray:
         """Electrical conductances [S] of the share's edges at the owned temperatures [K]

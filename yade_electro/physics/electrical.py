@@ -277,7 +277,7 @@ class ElectricalModel:
         its ends, a surface half cell's given to its element (``sharing='edges'``); or, with
         ``sharing='cells'`` and the elements' ``volume`` [m^3], that total given by the field
         over each cell (:func:`~yade_electro.physics.thermal.cell_joule_sources`; an
-        electrode's own elements keep their edge share)."""
+        electrode's own elements and their neighbours keep their edge share)."""
         from ..network.kirchhoff import edge_power
         n, m = self.n_elements, self.network.edges.shape[0]
         p = eta * edge_power(self.solution.branch_current, self.conductance)
