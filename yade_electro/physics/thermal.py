@@ -158,7 +158,8 @@ def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources,
     A distributed rank: ``owned``, the number of its elements (the first rows of ``pos`` and
     ``potential``; the rest are ghosts, whose potentials the gradients use); ``volume``,
     ``resistivity`` and ``edge_sources`` are then the owned elements' (``held`` covers the
-    ghosts too), and ``reduce`` maps the rank's two sums (the kept edge power, the cells' power) to the sums over every rank."""
+    ghosts too), and ``reduce`` maps the rank's two sums (the kept edge power, the cells'
+    power) to the sums over every rank."""
     pos = np.asarray(pos, float)
     e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     n = pos.shape[0]
