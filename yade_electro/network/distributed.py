@@ -207,7 +207,7 @@ class PartitionedConduction:
     def held(self) -> np.ndarray:
         """(n_local,) bool: the local nodes (owned, then ghosts) that are an electrode's own
         elements, held at its potential."""
-        return self._el_local < len(self.names)
+        return (self._el_local >= 0) & (self._el_local < len(self.names))
 
     @property
     def network(self) -> LocalNetwork:

@@ -539,7 +539,7 @@ class DistributedElectroThermal:
             self.conduction.update_conductance(self._conductance(self.T), links)
             self.conduction.solve(self._potentials(), self._currents())
             power = self.eta * self.conduction.joule_power()
-            if self.joule_sharing == "cells":
+            if self.joule_sharing == "cells" and self.temperature0 is not None:   # the volumes: from the heat data
                 power = self._cell_sources(share, power)
             currents = self.conduction.electrode_currents()
             row["R_eq"] = self.conduction.equivalent_resistance() if len(self.electrodes) >= 2 else math.inf
