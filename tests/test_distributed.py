@@ -186,7 +186,9 @@ O.engines = O.engines + [eng.runner]
 O.run(2, True)
 eng.set_electrode("a", 2.0)
 O.run(1, True)
-print("R_EQ", world_rank(), eng.equivalent_resistance, eng.electrode_currents["a"], flush=True)
+import sys      # one write per line: print() writes its pieces apart, and the two ranks' pieces interleaved
+sys.stdout.write(f"R_EQ {world_rank()} {eng.equivalent_resistance} {eng.electrode_currents['a']}\\n")
+sys.stdout.flush()
 if world_rank() == 1:
     O.bodies[int(ids[-1])].shape.radius = -1.0      # this rank's reader now fails; the other waits for it
 O.run(2, True)
