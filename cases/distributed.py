@@ -17,9 +17,10 @@ Cases (each prints its figures; rank 0 ends with one JSON line of them all):
     ROD_I and 0.5 W of heat, the bottom face grounded and held at 293 K, convection on the
     side, a source in the whole rod (each rank chooses the faces' elements on its region).
 ``rod-cells``
-    The ``rod`` case with ``Integrator(joule_sharing='cells')``: each element's Joule heat
-    from the field over its cell (gradients from the ghosts' potentials, the total summed over
-    the ranks).
+    The ``rod`` case with ``Integrator(joule_sharing='cells')``, the default under 'voronoi'
+    (``rod`` itself keeps 'edges'): each element's Joule heat from the field over its cell
+    (gradients from the ghosts' potentials, the total summed over the ranks; the electrode
+    layers' elements and their neighbours, ghosts included, keep the links' share).
 ``bed``
     A granular bed settling on a floor under gravity (hexagonal lattice, contact law), Joule-
     heated between its two ends, one end at 293 K, Crank-Nicolson, serial engine beside the

@@ -50,13 +50,16 @@ R_dem. Against the theory (power P_th = V^2 / R_th released in the volume pi R^2
      t / (rho c pi R^2 L) (= power factor x capacity factor);
   3. and, for the record, the rod mean against T(t) above (all three factors).
 
-  Measured at 5,000 elements, seed 1 (seeds 2, 3 in docs/validation.md): voronoi core -0.32 %, rod
-  mean vs energy balance -0.15 %; continuum -2.7 % and -1.6 %. The core's own figures are
-  printed too: the potential gradient in the core is 0.998 of V / L_eff for both models
-  (the equipotential of a rough layer of electrode elements is not exactly at their mean
-  centre plane z = r_mean), so the core heats 0.4 % slower from the field alone; the core's
-  heating rate P / C is 0.997 (voronoi) and 0.971 (continuum: core under-conduction 0.944
-  against the capacity deficit) of the theory. The integrator makes no difference (the
+  Measured at 5,000 elements, seed 1 (seeds 2, 3 in docs/results/joule_rod_seeds.csv): voronoi
+  core -0.17 %, rod mean vs energy balance -0.09 %; continuum -2.7 % and -1.6 %. The core's own
+  figures are printed too: the potential gradient in the core is 0.9989 (voronoi) and 0.998
+  (continuum) of V / L_eff (the equipotential of a rough layer of electrode elements is not
+  exactly at their mean centre plane z = r_mean), so the core heats 0.2-0.4 % slower from the
+  field alone; the core's heating rate P / C is 0.998 (voronoi) and 0.971 (continuum: core
+  under-conduction 0.944 against the capacity deficit) of the theory. Under voronoi the Joule
+  heat is given by the cells (``Integrator(joule_sharing='auto')``, the default): each slab of
+  the rod between the end slabs gets 0.9982-0.9983 of the theory's power density (0.995-1.000
+  with the links' half-and-half sharing, core -0.20 %). The integrator makes no difference (the
   heat balance is exact; the core temperatures agree to 1e-5).
 
 Run
