@@ -22,6 +22,7 @@ import numpy as np
 from ..geometry.shapes import Shape, as_shape
 from ..geometry.volumes import container_volume
 from .cache import cache_key, cache_path, load_cached, store
+from .grading import Refinement, graded_cloud
 from .jamming import Relaxer, jam, max_overlap, shrink_to_remove_overlaps
 from .radii import mean_radius_for_count, uniform_radii
 
@@ -95,7 +96,7 @@ class SpherePacking:
         return -self.shape.sdf(self.centers if points is None else points)
 
 
-def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache_dir=None,
+def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache_dir=None, refine=None,
                   **opts) -> SpherePacking:
     """Fill a container densely with spheres (placement only; numpy/scipy, no YADE).
 
@@ -123,6 +124,11 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
     cache_dir : str or Path or False, optional
         Where results are cached as ``.npz`` (key: hash of all parameters); default
         ``$YADE_ELECTRO_CACHE`` or ``~/.cache/yade_electro``. ``False`` disables the cache.
+    refine : Refinement, optional
+        Smaller elements in a region (:class:`~yade_electro.packing.grading.Refinement`), with
+        ``n``: the initial centres are drawn with a number density proportional to
+        ``size^-3`` and the radii in proportion to the size at each centre; eq. 1 on those
+        sizes gives the radius far from the region.
     **opts
         ``fraction`` (0.63) of eq. 1; ``method``: ``"jam"`` (default, no overlap, the
         radii stop growing where the packing jams) or ``"target"`` (keep the eq. 1 radii,
@@ -153,14 +159,24 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
         raise ValueError(f"method must be 'jam' or 'target', got {o['method']!r}")
     if (n is None) == (r_mean is None):
         raise ValueError("give exactly one of n (number of spheres) or r_mean (mean radius [m])")
+    if refine is not None and not isinstance(refine, Refinement):
+        raise ValueError(f"refine must be a Refinement(region=..., factor=..., width=...) "
+                         f"(yade_electro.packing.grading), got {refine!r}")
+    if refine is not None and n is None:
+        raise ValueError("a graded packing (refine=...) takes n, the number of spheres, not r_mean")
     shape = as_shape(predicate)
     t0 = time.perf_counter()
     volume, vmethod = container_volume(shape, n_samples=int(o["volume_samples"]))
+    cloud = None
+    if refine is not None and int(n) >= 2:      # the centres first: the radii follow the size at each
+        cloud = graded_cloud(shape, refine, int(n), float(dispersion), np.random.default_rng(int(seed)))
     if n is not None:
         n = int(n)
         if n < 2:
             raise ValueError(f"n must be >= 2, got {n}")
         r_req = mean_radius_for_count(volume, n, o["fraction"])
+        if cloud is not None:       # eq. 1 on the graded sizes: the radius far from the region
+            r_req /= float(np.mean(cloud[1] ** 3)) ** (1.0 / 3.0)
     else:
         r_req = float(r_mean)
         if not r_req > 0:
@@ -171,6 +187,7 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
                              f"{volume:.4g} m^3 ({n} sphere(s)); use a smaller r_mean")
     key = dict(version=PACKING_VERSION, shape=shape.key(), n=n, r_mean=r_req,
                dispersion=float(dispersion), seed=int(seed),
+               **({"refine": refine.key()} if refine is not None else {}),
                **{k: (float(v) if isinstance(v, (int, float)) and k != "max_steps" else v)
                   for k, v in o.items()})
     blob = cache_key(key, shape)
@@ -181,12 +198,12 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
         return SpherePacking(centers, radii, shape=shape, from_cache=True, **meta)
 
     rng = np.random.default_rng(int(seed))
-    rho = uniform_radii(n, 1.0, float(dispersion), rng)  # units of r_req
+    rho = uniform_radii(n, 1.0, float(dispersion), rng) if cloud is None else cloud[1]  # units of r_req
     log.info("dense_packing: %d spheres, r_mean %.4g m, container %.4g m^3 (%s)", n, r_req,
              volume, vmethod)
     x, s, info = jam(shape, rho, r_req, rng, phi_start=o["phi_start"], s_max=1.0,
                       tol=o["tol"], ds0=0.02, ds_min=o["ds_min"], max_steps=int(o["max_steps"]),
-                      skin=o["skin"], volume=volume)
+                      skin=o["skin"], volume=volume, initial=None if cloud is None else cloud[0] / r_req)
     if o["method"] == "target" and s < 1.0:
         rel = Relaxer(shape, rho, r_req, skin=o["skin"])
         x, _, _, steps = rel.minimise(x, 1.0, o["tol"], 10 * int(o["max_steps"]),

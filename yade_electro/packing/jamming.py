@@ -270,7 +270,7 @@ def random_inside(shape, rad, r0, rng, max_rounds=200):
                      "large for it (ask for more spheres or a smaller r_mean)")
 
 
-def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume):
+def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, skin, volume, initial=None):
     """Grow the radius scale ``s`` from ``phi_start`` to jamming (bisection on ``s``). A run
     longer than :data:`PROGRESS_EVERY` seconds prints a progress line that often.
 
@@ -282,7 +282,8 @@ def jam(shape, rho, r0, rng, *, phi_start, s_max, tol, ds0, ds_min, max_steps, s
     step with its share of list rebuilds takes 148 ms instead of 513 ms."""
     phi_nom = float(np.sum(4 / 3 * np.pi * (rho * r0) ** 3)) / volume  # fraction at s = 1
     s = min(s_max, (phi_start / phi_nom) ** (1 / 3))
-    x = random_inside(shape, s * rho, r0, rng)
+    # the initial cloud: uniform, or given (a graded cloud, units of r0)
+    x = random_inside(shape, s * rho, r0, rng) if initial is None else np.array(initial, float)
     order = morton_order(x) if rho.size >= SPATIAL_ORDER_FROM else None
     if order is not None:
         x, rho = x[order], rho[order]

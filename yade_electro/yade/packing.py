@@ -9,14 +9,14 @@ holds no code of its own; it names what the three modules hold.
 """
 from ..geometry.shapes import (Box, Cylinder, Difference, GridShape, Intersection, Shape, Sphere, Union, as_shape)
 from ..geometry.volumes import container_volume
-from ..packing import (DEFAULT_DETECTION_FACTOR, PACKING_VERSION, SpherePacking, bond_pairs, dense_packing,
-                       detection_factor_for_coordination, mean_radius_for_count, packing_statistics)
+from ..packing import (DEFAULT_DETECTION_FACTOR, PACKING_VERSION, Refinement, SpherePacking, bond_pairs,
+                       dense_packing, detection_factor_for_coordination, mean_radius_for_count, packing_statistics)
 from .bonding import add_bonded_packing, steel_304L
 from .spheres import bonded_packing
 
 __all__ = [
     "Shape", "Cylinder", "Box", "Sphere", "Difference", "Intersection", "Union", "GridShape",
-    "as_shape", "container_volume", "mean_radius_for_count", "SpherePacking", "dense_packing",
+    "as_shape", "container_volume", "mean_radius_for_count", "SpherePacking", "dense_packing", "Refinement",
     "bond_pairs", "detection_factor_for_coordination", "packing_statistics",
     "add_bonded_packing", "bonded_packing", "steel_304L", "DEFAULT_DETECTION_FACTOR", "PACKING_VERSION",
 ]
