@@ -14,7 +14,10 @@ thickness at mid-length, 0.6 mm long and 0.45 mm deep, one from each side: the l
   the cells of the DEM elements nearest to it (finest mesh).
 * **DEM**: ``ElectroThermalEngine``, law 'voronoi' (cells bounded by the exact container),
   surface electrodes on the end faces, backward Euler of 0.05 ms, ``--n`` elements, seeds
-  ``--seeds``.
+  ``--seeds``. ``--refine F``: a graded packing of the same ``--n``, its elements F times
+  smaller within 0.7 mm of the middle (:class:`yade_electro.packing.Refinement`, back to the
+  full size over 0.4 mm): the field's singular edges at the notches get finer cells, the
+  uniform arms coarser ones, which the Voronoi network carries exactly anyway.
 
 At the recorded times, for the element whose centre is nearest the ligament's centre:
 
@@ -35,6 +38,7 @@ Run
 ---
     yade-electro -n -x cases/narrow_ligament.py [--n 10000] [--seeds 1,2,3,4] [--quick]
     yade-electro -n -x cases/narrow_ligament.py --notch-depth 0.3e-3   # notched_joule's 0.5 mm ligament
+    yade-electro -n -x cases/narrow_ligament.py --refine 0.75 --sharing cells   # graded: smaller elements there
 
 Ends with one JSON line.
 """
@@ -98,16 +102,26 @@ def cell_samples(centres, radius, k: int, per_cell: int, seed: int = 5, depth: f
     return pts[:per_cell]
 
 
-def dem_run(n: int, seed: int, times, cache_dir=None, sharing: str = "edges", depth: float = NOTCH_DEPTH) -> dict:
+def refinement(factor: float):
+    """Smaller elements around the ligament: radius ``factor`` within 0.7 mm of the bar's
+    middle along x (the notches and 0.4 mm beyond them), back to the full size over 0.4 mm."""
+    from yade_electro.packing import Refinement
+    from yade_electro.geometry.shapes import Box
+    half, big = 0.7e-3, 10.0 * LENGTH
+    return Refinement(Box((0.5 * LENGTH - half, -big, -big), (0.5 * LENGTH + half, big, big)), factor, 0.4e-3)
+
+
+def dem_run(n: int, seed: int, times, cache_dir=None, sharing: str = "edges", depth: float = NOTCH_DEPTH,
+            refine=None) -> dict:
     """The DEM heating; temperatures of every element at ``times`` [s] and R_eq; ``sharing``: the
-    Joule heat's ``Integrator(joule_sharing=...)``."""
+    Joule heat's ``Integrator(joule_sharing=...)``; ``refine``: a graded packing's Refinement."""
     from yade_electro.yade import ElectroThermalEngine, Electrode, Integrator, Law, Material
     from yade_electro.yade import packing as P
     from yade_electro.yade.runtime import import_yade
     O = import_yade().Omega()
     O.reset()
     sh = shape(depth)
-    pk = P.dense_packing(sh, n=n, seed=seed, cache_dir=cache_dir)
+    pk = P.dense_packing(sh, n=n, seed=seed, cache_dir=cache_dir, refine=refine)
     P.add_bonded_packing(pk)
     for e in O.engines:
         if type(e).__name__ == "NewtonIntegrator":
@@ -148,6 +162,8 @@ def main(argv=None) -> dict:
     ap.add_argument("--sharing", default="edges,cells", help="Integrator(joule_sharing=...) values, each run")
     ap.add_argument("--notch-depth", type=float, default=NOTCH_DEPTH,
                     help="notch depth from each side [m] (0.45e-3: the 0.2 mm ligament; 0.3e-3: notched_joule's 0.5 mm)")
+    ap.add_argument("--refine", type=float, default=None,
+                    help="a graded packing: elements this factor smaller near the ligament (e.g. 0.75), same --n")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--cache-dir", default=None)
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
@@ -161,7 +177,8 @@ def main(argv=None) -> dict:
     for seed in seeds:
         for sharing in args.sharing.split(","):
             sys.stderr.write(f"[narrow_ligament] DEM n={args.n} seed={seed} joule_sharing={sharing}\n")
-            dems.append(dem_run(args.n, seed, times, args.cache_dir, sharing, args.notch_depth))
+            dems.append(dem_run(args.n, seed, times, args.cache_dir, sharing, args.notch_depth,
+                                None if args.refine is None else refinement(args.refine)))
     # the FEM: its points are the ligament's centre, each run's nearest element's centre and
     # the samples of that element's cell
     probes, slices = [CENTRE], []
@@ -182,6 +199,7 @@ def main(argv=None) -> dict:
     R_ref = fem.richardson(hs, fem_R)
     rec = [int(np.argmin(np.abs(fem_t - t))) for t in times]
     out = {"case": "narrow_ligament", "n": args.n, "seeds": seeds, "times_s": times, "ligament_m": WIDTH - 2 * args.notch_depth,
+           "refine_factor": args.refine,
            "fem_R_eq_ohm": fem_R, "fem_R_extrapolated_ohm": float(R_ref.extrapolated), "fem_R_gci_ohm": float(R_ref.gci),
            "fem_ndofs": fem_ndofs, "fem_centre_rise_K": (fem_T[rec, 0] - T0).tolist(), "runs": []}
     for d, (i_own, i_cell, i_end) in zip(dems, slices):
@@ -190,7 +208,9 @@ def main(argv=None) -> dict:
         point = fem_T[rec, 0] - T0
         own = fem_T[rec, i_own] - T0
         cell = fem_T[rec][:, i_cell:i_end].mean(axis=1) - T0
+        near = np.abs(d["pos"][:, 0] - CENTRE[0]) < 0.3e-3
         run = {"seed": d["seed"], "n": d["n"], "joule_sharing": d["sharing"], "R_eq_ohm": d["R_eq"],
+               "r_mean_m": float(d["radius"].mean()), "r_mean_ligament_m": float(d["radius"][near].mean()),
                "R_vs_fem_pct": 100 * (d["R_eq"] / R_ref.extrapolated - 1),
                "element_distance_to_centre_m": float(np.linalg.norm(d["pos"][k] - CENTRE)),
                "element_radius_m": float(d["radius"][k]), "cell_samples": int(i_end - i_cell),
