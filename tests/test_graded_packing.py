@@ -47,6 +47,8 @@ def test_a_refinement_is_checked_when_it_is_made():
         Refinement("the middle", factor=0.5)
     with pytest.raises(ValueError, match="takes n"):
         dense_packing(BAR, r_mean=0.1e-3, refine=Refinement(MIDDLE, 0.5), cache_dir=False)
+    with pytest.raises(ValueError, match="dispersion"):
+        dense_packing(BAR, n=100, dispersion=3, refine=Refinement(MIDDLE, 0.5), cache_dir=False)
     with pytest.raises(ValueError, match="refine must be a Refinement"):
         dense_packing(BAR, n=100, refine=0.5, cache_dir=False)
     step = Refinement(MIDDLE, factor=0.5)                      # width 0: a step at the region's surface

@@ -74,6 +74,8 @@ def graded_cloud(shape, refinement: Refinement, n: int, dispersion: float, rng, 
     """``n`` random centres [m] inside ``shape`` with a number density proportional to
     ``size^-3``, and their relative radii: the size at each centre times a factor uniform in
     ``[1 - dispersion/2, 1 + dispersion/2]``. Returns (centres (n, 3), relative radii (n,))."""
+    if not 0 <= dispersion < 2:
+        raise ValueError(f"dispersion must be in [0, 2), got {dispersion} (0.25 = radii in size*[0.875, 1.125])")
     lo, hi = (np.asarray(b, float) for b in shape.bounds())
     got, have = [], 0
     for _ in range(10_000):
