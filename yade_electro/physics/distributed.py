@@ -338,14 +338,15 @@ class DistributedElectroThermal:
         S = exchange.local(S[:share.n_owned])
         return np.sqrt(S[g.edges[:, 0]] * S[g.edges[:, 1]]) / edge_lengths(g, g.edges)
 
-    def _capacity(self, share: Share) -> np.ndarray:
-        g, n, m = share.graph, share.n_owned, self.material
+    def _volume(self, share: Share) -> np.ndarray:
+        """The volume each owned element stands for [m^3] (its heat capacity over rho c)."""
+        g, n = share.graph, share.n_owned
         if g is None:
             return np.zeros(0)
         if share.volume is not None and self.volume_fraction is None:     # cells that fill the solid
-            return m.density * m.specific_heat * share.volume
+            return share.volume
         fv = volume_fraction(g)[:n] if self.volume_fraction is None else self.volume_fraction
-        return m.density * m.specific_heat * g.volume[:n] / fv
+        return g.volume[:n] / fv
 
     def _cell_sources(self, share: Share, power) -> np.ndarray:
         """The owned elements' Joule heat [W] by :func:`.thermal.cell_joule_sources`, the total
@@ -355,11 +356,10 @@ class DistributedElectroThermal:
             summed(self.comm, np.zeros(2))
             return power
         m, c = self.material, self.conduction
-        volume = self._capacity(share) / (m.density * m.specific_heat)
         rho = m.resistivity_at(None if m.beta == 0.0 else np.asarray(self.T, float))
         edges = c.network.edges[np.asarray(c.conductance) > 0]
-        return cell_joule_sources(share.graph.pos, edges, c.potential, volume, rho, power, owned=share.n_owned,
-                                  reduce=lambda v: summed(self.comm, v), held=c.held)
+        return cell_joule_sources(share.graph.pos, edges, c.potential, self._volume(share), rho, power,
+                                  owned=share.n_owned, reduce=lambda v: summed(self.comm, v), held=c.held)
 
     def _conductance(self, T_owned) -> np.ndarray:
         """Electrical conductances [S] of the share's edges at the owned temperatures [K]
@@ -391,8 +391,7 @@ class DistributedElectroThermal:
         n = share.n_owned
         pos = share.graph.pos[:n] if share.graph is not None else np.zeros((0, 3))
         spacing = self._spacing(share)
-        T = self._temperatures(share)
-        self.T = T
+        self.T = T = self._temperatures(share)
         self._pos, self._spacing_now = pos, spacing
         if self.electrodes:
             self._new_conduction(share, T)
@@ -407,7 +406,8 @@ class DistributedElectroThermal:
                 t_inf[on] = (t_inf[on] * hA[on] + item.h * area[on] * item.t_inf) / np.maximum(
                     hA[on] + item.h * area[on], 1e-300)
                 hA[on] += item.h * area[on]
-            self.heat = PartitionedHeat(net, self._capacity(share), self._thermal(), T,
+            rho_c = self.material.density * self.material.specific_heat
+            self.heat = PartitionedHeat(net, rho_c * self._volume(share), self._thermal(), T,
                                         fixed=fixed, h_area=hA, t_inf=t_inf, theta=self.theta, comm=self.comm,
                                         preconditioner=self.preconditioner, rtol=1e-12, pos=pos, spacing=spacing,
                                         safety=self.safety, max_substeps=self.max_substeps, smoother=self.smoother,
@@ -421,12 +421,12 @@ class DistributedElectroThermal:
 
     def _feed_power(self, share: Share, fixed) -> np.ndarray:
         """The feeds' power [W] on each owned node, held ones excluded (collective)."""
-        n, m = share.n_owned, self.material
+        n = share.n_owned
         q = np.zeros(n)
         for f in self.feeds:
             on = self._chosen(f, share)
             if f.kind == "source":
-                w = self._capacity(share) / (m.density * m.specific_heat) if n else np.zeros(0)
+                w = self._volume(share) if n else np.zeros(0)
             elif f.surface is not None:
                 w = self._surface_values(f.name, share)
             elif f.rate is not None or f.area is not None:
