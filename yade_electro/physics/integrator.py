@@ -114,11 +114,7 @@ class Integrator:
             raise ValueError(f"Integrator safety must be in (0, 1], got {self.safety}")
         if not 0.0 <= real_number("Integrator eta", self.eta) <= 1.0:
             raise ValueError(f"Integrator eta must be in [0, 1], got {self.eta}")
-        if self.joule_sharing not in JOULE_SHARINGS:
-            raise ValueError(f"Integrator joule_sharing must be 'auto' (cells under the voronoi law, edges "
-                             f"otherwise), 'edges' (each link's Joule heat half and half to its ends) or 'cells' "
-                             f"(from the field over each element's cell), got "
-                             f"{self.joule_sharing!r}")
+        joule_sharing_for(self.joule_sharing, "voronoi")         # a known name
         for name in ("max_substeps", "coupling_iterations"):
             v = getattr(self, name)
             if isinstance(v, bool) or int(v) != v or v < (1 if name == "max_substeps" else 0):
@@ -140,7 +136,9 @@ def joule_sharing_for(sharing: str, law_name: str) -> str:
     """``'edges'`` or ``'cells'``: what ``sharing`` (one of :data:`JOULE_SHARINGS`) means
     under the conduction law named ``law_name``; ValueError for an unknown sharing."""
     if sharing not in JOULE_SHARINGS:
-        raise ValueError(f"joule_sharing must be one of {', '.join(JOULE_SHARINGS)}, got {sharing!r}")
+        raise ValueError(f"joule_sharing must be 'auto' (cells under the voronoi law, edges otherwise), 'edges' "
+                         f"(each link's Joule heat half and half to its ends) or 'cells' (from the field over each "
+                         f"element's cell), got {sharing!r}")
     if sharing != "auto":
         return sharing
     return "cells" if law_name == "voronoi" else "edges"
