@@ -191,7 +191,8 @@ def cell_joule_sources(pos, edges, potential, volume, resistivity, edge_sources,
         ok[unsure] = eig[:, 0] > 1e-6 * np.maximum(eig[:, 2], 1e-300)
     ok &= p_edge > 0
     if held is not None:                       # held elements and their neighbours keep theirs
-        ok &= ~((at_ends(np.asarray(held, bool)[e].any(axis=1).astype(float)) > 0) | np.asarray(held, bool)[:r])
+        h = np.asarray(held, bool)
+        ok &= ~(h[:r] | (at_ends(h[e].any(axis=1).astype(float)) > 0))
     b0, b1, b2 = (at_ends(wd[:, a] * du) for a in range(3))
     g = np.column_stack([c00 * b0 + c01 * b1 + c02 * b2, c01 * b0 + c11 * b1 + c12 * b2,
                          c02 * b0 + c12 * b1 + c22 * b2]) / np.where(ok, det, 1.0)[:, None]
