@@ -167,16 +167,11 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
     shape = as_shape(predicate)
     t0 = time.perf_counter()
     volume, vmethod = container_volume(shape, n_samples=int(o["volume_samples"]))
-    cloud = None
-    if refine is not None and int(n) >= 2:      # the centres first: the radii follow the size at each
-        cloud = graded_cloud(shape, refine, int(n), float(dispersion), np.random.default_rng(int(seed)))
     if n is not None:
         n = int(n)
         if n < 2:
             raise ValueError(f"n must be >= 2, got {n}")
         r_req = mean_radius_for_count(volume, n, o["fraction"])
-        if cloud is not None:       # eq. 1 on the graded sizes: the radius far from the region
-            r_req /= float(np.mean(cloud[1] ** 3)) ** (1.0 / 3.0)
     else:
         r_req = float(r_mean)
         if not r_req > 0:
@@ -197,6 +192,10 @@ def dense_packing(predicate, n=None, r_mean=None, dispersion=0.25, seed=0, cache
         centers, radii, meta = hit
         return SpherePacking(centers, radii, shape=shape, from_cache=True, **meta)
 
+    cloud = None
+    if refine is not None:          # the centres first, the radii follow the size at each (same n, seed)
+        cloud = graded_cloud(shape, refine, n, float(dispersion), np.random.default_rng(int(seed)))
+        r_req /= float(np.mean(cloud[1] ** 3)) ** (1.0 / 3.0)      # eq. 1 on the graded sizes: far from the region
     rng = np.random.default_rng(int(seed))
     rho = uniform_radii(n, 1.0, float(dispersion), rng) if cloud is None else cloud[1]  # units of r_req
     log.info("dense_packing: %d spheres, r_mean %.4g m, container %.4g m^3 (%s)", n, r_req,
